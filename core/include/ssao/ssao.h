@@ -1,0 +1,145 @@
+/* SPDX-License-Identifier: MIT
+ * libssao: screen-space ambient occlusion for offline renders. The stable C API. */
+#ifndef SSAO_SSAO_H
+#define SSAO_SSAO_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+/* -------------------------------------------------------------------------------------------
+ * Conventions
+ *
+ * - Every function that can fail returns an ssao_status: SSAO_OK (0) or an error. The message
+ *   of the last failure on the calling thread is returned by ssao_last_error().
+ * - A job (ssao_job) holds parameters and image views. Set parameters by name, attach caller-owned
+ *   float images, then call ssao_job_run(). Parameters keep their values between runs.
+ * - Parameter names, types, defaults, ranges and units are listed by ssao_param_info() and in
+ *   docs/api.md. Unknown names, wrong types and out-of-range values are errors, never ignored.
+ * - Images are 32-bit float, caller-owned, and read or written in place. Pixel (x, y), with
+ *   y = 0 the TOP row, channel c, is the float at
+ *       (char*)data + y * row_stride + x * pixel_stride + c * sizeof(float)
+ *   Strides are in bytes; 0 means tightly packed (pixel_stride = channels * 4,
+ *   row_stride = width * pixel_stride). A negative row_stride reads bottom-up buffers (such as
+ *   Blender's): pass a pointer to the top row, which is the LAST row in memory.
+ *   Image memory must stay valid until ssao_job_run() returns.
+ * - Coordinates: view space looks down -Z with +Y up and +X right (Blender/OpenGL cameras).
+ *   Depth is the positive distance along the view axis ("planar", Blender's Depth pass) or
+ *   along the pixel's ray ("radial"). A depth that is NaN, infinite, <= 0, >= background_depth
+ *   or >= clip_end (when clip_end > 0) marks a background pixel: it is never an occluder and its
+ *   AO is 1 (unoccluded).
+ * - AO is visibility: 1 = unoccluded, 0 = fully occluded.
+ * - Results are bitwise identical for any thread count.
+ *
+ * Thread safety: functions may be called from any thread. Distinct jobs may be used concurrently;
+ * one job must not be used by two threads at once. ssao_job_run() runs on the calling thread
+ * plus "threads" - 1 worker threads; the progress callback is only ever called on the calling
+ * thread.
+ * ------------------------------------------------------------------------------------------- */
+
+#if defined(_WIN32)
+#  if defined(SSAO_BUILDING_LIBRARY)
+#    define SSAO_API __declspec(dllexport)
+#  else
+#    define SSAO_API __declspec(dllimport)
+#  endif
+#else
+#  define SSAO_API __attribute__((visibility("default")))
+#endif
+
+#define SSAO_VERSION_MAJOR 0
+#define SSAO_VERSION_MINOR 1
+#define SSAO_VERSION_PATCH 0
+/* MAJOR * 10000 + MINOR * 100 + PATCH; compare with ssao_version() at run time. */
+#define SSAO_VERSION (SSAO_VERSION_MAJOR * 10000 + SSAO_VERSION_MINOR * 100 + SSAO_VERSION_PATCH)
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef enum ssao_status {
+  SSAO_OK = 0,                      /* success */
+  SSAO_ERROR_INVALID_ARGUMENT = 1,  /* bad handle, name, type, value, size or stride */
+  SSAO_ERROR_INVALID_OPERATION = 2, /* e.g. run without a depth image or without any output */
+  SSAO_ERROR_OUT_OF_MEMORY = 3,     /* an allocation failed */
+  SSAO_ERROR_CANCELLED = 4,         /* the progress callback asked to stop */
+  SSAO_ERROR_INTERNAL = 5           /* unexpected internal error (a bug: please report it) */
+} ssao_status;
+
+typedef enum ssao_param_type {
+  SSAO_PARAM_INT = 0,    /* set with ssao_job_set_int */
+  SSAO_PARAM_FLOAT = 1,  /* set with ssao_job_set_float */
+  SSAO_PARAM_STRING = 2, /* one of a fixed set of choices; set with ssao_job_set_string */
+  SSAO_PARAM_FLOATS = 3  /* fixed-length float array; set with ssao_job_set_floats */
+} ssao_param_type;
+
+/* Describes one parameter. Strings are static and never freed. */
+typedef struct ssao_param_desc {
+  const char* name;           /* e.g. "radius" */
+  ssao_param_type type;       /* how to set it */
+  double default_value;       /* INT and FLOAT */
+  double min_value;           /* INT and FLOAT: inclusive lower bound */
+  double max_value;           /* INT and FLOAT: inclusive upper bound */
+  const char* default_string; /* STRING: the default choice; FLOATS: NULL */
+  const char* choices;        /* STRING: choices separated by '|'; others: NULL */
+  size_t count;               /* FLOATS: number of values; others: 1 */
+  const char* unit;           /* e.g. "scene units", "fraction of radius", "" */
+  const char* description;    /* one sentence */
+} ssao_param_desc;
+
+/* Called with the fraction done in [0, 1], non-decreasing. Return 0 to cancel the run. */
+typedef int (*ssao_progress_fn)(void* user, double fraction);
+
+typedef struct ssao_job_impl* ssao_job;
+
+/* Returns the library version as SSAO_VERSION encodes it. */
+SSAO_API int ssao_version(void);
+/* Returns a static description of a status code. */
+SSAO_API const char* ssao_status_string(ssao_status status);
+/* Returns the message of the last failed call on this thread, "" if none. Valid until the next
+   failing call on this thread. */
+SSAO_API const char* ssao_last_error(void);
+
+/* Returns the number of parameters; index them with ssao_param_info(). */
+SSAO_API size_t ssao_param_count(void);
+/* Describes parameter number "index" (0 <= index < ssao_param_count()). */
+SSAO_API ssao_status ssao_param_info(size_t index, ssao_param_desc* out);
+
+/* Creates a job with every parameter at its default and no images attached. */
+SSAO_API ssao_status ssao_job_create(ssao_job* out);
+/* Destroys a job. NULL is a no-op. */
+SSAO_API void ssao_job_destroy(ssao_job job);
+
+SSAO_API ssao_status ssao_job_set_int(ssao_job job, const char* name, int value);
+SSAO_API ssao_status ssao_job_set_float(ssao_job job, const char* name, double value);
+SSAO_API ssao_status ssao_job_set_string(ssao_job job, const char* name, const char* value);
+SSAO_API ssao_status ssao_job_set_floats(ssao_job job, const char* name, const double* values,
+                                         size_t count);
+SSAO_API ssao_status ssao_job_get_int(ssao_job job, const char* name, int* out);
+SSAO_API ssao_status ssao_job_get_float(ssao_job job, const char* name, double* out);
+/* Copies the value (NUL-terminated, truncated to size) into out. */
+SSAO_API ssao_status ssao_job_get_string(ssao_job job, const char* name, char* out, size_t size);
+SSAO_API ssao_status ssao_job_get_floats(ssao_job job, const char* name, double* out,
+                                         size_t count);
+
+/* Attaches (or, with data == NULL, detaches) an image. Names:
+ *   "depth"     input, required, channel 0 read
+ *   "normal"    input, optional, channels 0..2 read (space given by "normal_space"); without it,
+ *               normals are reconstructed from depth
+ *   "beauty"    input, 1..4 channels, needed by "composite"
+ *   "ao"        output: AO written to channels 0..min(channels,3)-1, channel 3 (if any) set to 1
+ *   "composite" output: beauty with its first min(channels,3) channels multiplied by AO, the
+ *               rest copied; needs as many channels as "beauty" (may be the beauty buffer itself)
+ * All images of a job must have the depth image's width and height. */
+SSAO_API ssao_status ssao_job_set_image(ssao_job job, const char* name, float* data, int width,
+                                        int height, int channels, ptrdiff_t pixel_stride,
+                                        ptrdiff_t row_stride);
+/* Sets (or, with fn == NULL, clears) the progress callback. */
+SSAO_API ssao_status ssao_job_set_progress(ssao_job job, ssao_progress_fn fn, void* user);
+/* Computes AO and writes the attached outputs. A 0 x 0 image is valid and does nothing. */
+SSAO_API ssao_status ssao_job_run(ssao_job job);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* SSAO_SSAO_H */

@@ -1,0 +1,49 @@
+// SPDX-License-Identifier: MIT
+// Finds the render passes (depth, normal, beauty) among the channel names of an EXR file.
+//
+// Blender's "OpenEXR MultiLayer" files name channels <layer>.<pass>.<component>:
+//   depth   <layer>.Depth.Z
+//   normal  <layer>.Normal.X, <layer>.Normal.Y, <layer>.Normal.Z
+//   beauty  <layer>.Combined.R, .G, .B and, if present, .A
+// The layer is the view layer's name ("ViewLayer" by default, any name in general, possibly
+// with dots). Every channel ending in ".Depth.Z" names a candidate layer; when there are several
+// the caller must choose one (--layer), the error lists them.
+//
+// Files without layers are accepted too. Depth is looked up, in this order, as
+//   Depth.Z, Z, depth, Depth
+// normals as Normal.{X,Y,Z} then N.{X,Y,Z}, and beauty as Combined.{R,G,B[,A]} then R, G, B[, A].
+// Any of the three can be named explicitly instead (PassOverrides).
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "io/error.h"
+
+namespace ssao_io {
+
+struct PassOverrides {
+  std::string layer;                         // "" = detect
+  std::string depth_channel;                 // "" = detect
+  std::vector<std::string> normal_channels;  // empty = detect, else exactly 3 names
+  std::vector<std::string> beauty_channels;  // empty = detect, else 3 or 4 names
+  bool no_normals = false;                   // ignore the normal pass entirely
+};
+
+struct PassChannels {
+  std::string layer;                         // "" for a file without layers
+  std::string depth;                         // always set
+  std::vector<std::string> normal;           // empty or X, Y, Z
+  std::vector<std::string> beauty;           // empty or R, G, B[, A]
+};
+
+// The view layers that have a depth pass ("<layer>.Depth.Z"), in channel order.
+std::vector<std::string> layers_with_depth(const std::vector<std::string>& channels);
+
+// Chooses the channels to use. `file` only appears in messages. Throws Error when no depth
+// channel is found (the message lists the channels that exist), when several layers have a
+// depth pass and none was chosen, or when an explicitly named channel or layer does not exist.
+PassChannels detect_passes(const std::vector<std::string>& channels, const PassOverrides& overrides,
+                           const std::string& file);
+
+}  // namespace ssao_io

@@ -1,0 +1,56 @@
+// SPDX-License-Identifier: MIT
+// The camera description that travels beside a rendered image (docs: conventions.md), e.g.
+//   {"type": "PERSP", "lens": 35.0, "sensor_width": 36.0, "sensor_height": 24.0,
+//    "sensor_fit": "AUTO", "shift_x": 0.0, "shift_y": 0.0, "ortho_scale": 6.0,
+//    "clip_start": 0.1, "clip_end": 1000.0, "matrix_world": [[4 numbers] x 4 rows]}
+// Keys are named after Blender's bpy.types.Camera properties. "type" is required; every other
+// key is optional and defaults to Blender's default for a new camera (below); matrix_world
+// (camera-to-world, row-major, camera looking down its local -Z with +Y up) defaults to the
+// identity. Optional "pixel_aspect_x"/"pixel_aspect_y" (render settings) default to 1. Keys
+// the format does not know are reported in Camera::unknown_keys and otherwise ignored.
+#pragma once
+
+#include <array>
+#include <string>
+#include <vector>
+
+#include "io/error.h"
+#include "ssao/ssao.h"
+
+namespace ssao_io {
+
+struct Camera {
+  std::string type = "PERSP";  // "PERSP" | "ORTHO"
+  double lens = 50.0;          // mm
+  double sensor_width = 36.0;  // mm
+  double sensor_height = 24.0; // mm
+  std::string sensor_fit = "AUTO";  // "AUTO" | "HORIZONTAL" | "VERTICAL"
+  double shift_x = 0.0;
+  double shift_y = 0.0;
+  double ortho_scale = 6.0;
+  double clip_start = 0.1;
+  double clip_end = 1000.0;  // Blender's default since 2.80 (it was 100 before)
+  double pixel_aspect_x = 1.0;
+  double pixel_aspect_y = 1.0;
+  std::array<double, 16> matrix_world = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
+  std::vector<std::string> unknown_keys;  // present in the file, not part of the format
+};
+
+// Reads and validates a camera file. Throws Error, naming the file and the key, for a missing
+// or unreadable file, malformed JSON, a root that is not an object, a missing "type", a value
+// of the wrong JSON type, a non-finite number, an unknown choice or a matrix that is not 4x4.
+Camera read_camera_json(const std::string& path);
+
+// Same from the text of a file; `source` names it in messages.
+Camera parse_camera_json(const std::string& text, const std::string& source);
+
+// The core parameters apply_camera() sets: camera_type, lens, sensor_width, sensor_height,
+// sensor_fit, shift_x, shift_y, ortho_scale, clip_start, clip_end, pixel_aspect_x,
+// pixel_aspect_y, camera_to_world.
+const std::vector<std::string>& camera_param_names();
+
+// Sets the camera parameters of `job` through the C API. `source` (the file name) prefixes the
+// messages. Throws Error with ssao_last_error() when the core rejects a value.
+void apply_camera(ssao_job job, const Camera& camera, const std::string& source);
+
+}  // namespace ssao_io

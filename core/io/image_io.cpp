@@ -1,0 +1,226 @@
+// SPDX-License-Identifier: MIT
+#include "io/image_io.h"
+
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <OpenImageIO/imageio.h>
+
+#include <cerrno>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
+#include <limits>
+#include <memory>
+#include <new>
+#include <system_error>
+
+namespace fs = std::filesystem;
+
+namespace ssao_io {
+namespace {
+
+std::string quoted(const std::string& path) { return "'" + path + "'"; }
+
+// OIIO's messages may end with a newline or be empty.
+std::string oiio_detail(std::string message) {
+  while (!message.empty() && (message.back() == '\n' || message.back() == ' ')) message.pop_back();
+  return message.empty() ? std::string("no details from OpenImageIO") : "OpenImageIO: " + message;
+}
+
+void require_readable_file(const std::string& path) {
+  std::error_code ec;
+  const fs::file_status status = fs::status(path, ec);
+  if (!fs::exists(status)) throw Error("cannot read " + quoted(path) + ": no such file");
+  if (fs::is_directory(status)) throw Error("cannot read " + quoted(path) + ": it is a directory");
+  if (::access(path.c_str(), R_OK) != 0) {
+    throw Error("cannot read " + quoted(path) + ": " + std::strerror(errno));
+  }
+}
+
+size_t checked_float_count(int width, int height, int channels, const std::string& path) {
+  if (width < 0 || height < 0 || channels <= 0) {
+    throw Error("cannot read " + quoted(path) + ": invalid image size " + std::to_string(width) +
+                " x " + std::to_string(height) + " x " + std::to_string(channels) + " channels");
+  }
+  const size_t limit = std::numeric_limits<size_t>::max() / sizeof(float);
+  size_t count = static_cast<size_t>(width);
+  for (const int factor : {height, channels}) {
+    if (factor != 0 && count > limit / static_cast<size_t>(factor)) {
+      throw Error("cannot read " + quoted(path) + ": image too large");
+    }
+    count *= static_cast<size_t>(factor);
+  }
+  return count;
+}
+
+// A temporary file next to the final one, removed on destruction unless committed.
+class TemporaryFile {
+ public:
+  explicit TemporaryFile(const std::string& final_path) {
+    const fs::path final_fs(final_path);
+    fs::path folder = final_fs.parent_path();
+    if (folder.empty()) folder = ".";
+    std::string pattern = (folder / ("." + final_fs.filename().string() + ".XXXXXX.tmp")).string();
+    std::vector<char> buffer(pattern.begin(), pattern.end());
+    buffer.push_back('\0');
+    fd_ = ::mkstemps(buffer.data(), 4);
+    if (fd_ < 0) {
+      throw Error("cannot write " + quoted(final_path) + ": cannot create a file in folder " +
+                  quoted(folder.string()) + ": " + std::strerror(errno));
+    }
+    path_ = buffer.data();
+    // mkstemps creates the file with mode 0600; give it the permissions of a normal new file.
+    const mode_t mask = ::umask(0);
+    ::umask(mask);
+    (void)::fchmod(fd_, static_cast<mode_t>(0666 & ~mask));
+  }
+  TemporaryFile(const TemporaryFile&) = delete;
+  TemporaryFile& operator=(const TemporaryFile&) = delete;
+  ~TemporaryFile() {
+    if (fd_ >= 0) ::close(fd_);
+    if (!committed_) ::unlink(path_.c_str());
+  }
+
+  const std::string& path() const { return path_; }
+
+  // Flushes the (already closed by its writer) file to disk and renames it to `final_path`.
+  void commit(const std::string& final_path) {
+    if (::fsync(fd_) != 0) {
+      throw Error("cannot write " + quoted(final_path) + ": " + std::strerror(errno));
+    }
+    ::close(fd_);
+    fd_ = -1;
+    if (std::rename(path_.c_str(), final_path.c_str()) != 0) {
+      throw Error("cannot write " + quoted(final_path) + ": " + std::strerror(errno));
+    }
+    committed_ = true;
+  }
+
+ private:
+  std::string path_;
+  int fd_ = -1;
+  bool committed_ = false;
+};
+
+}  // namespace
+
+int Image::find_channel(const std::string& name) const {
+  for (size_t i = 0; i < channel_names.size(); ++i) {
+    if (channel_names[i] == name) return static_cast<int>(i);
+  }
+  return -1;
+}
+
+std::string join_names(const std::vector<std::string>& names, const char* separator) {
+  std::string out;
+  for (size_t i = 0; i < names.size(); ++i) {
+    if (i > 0) out += separator;
+    out += names[i];
+  }
+  return out;
+}
+
+Image read_image(const std::string& path) {
+  require_readable_file(path);
+  auto input = OIIO::ImageInput::open(path);
+  if (!input) {
+    throw Error("cannot read " + quoted(path) + ": not an image file OpenImageIO can read, or " +
+                "its header is damaged (" + oiio_detail(OIIO::geterror()) + ")");
+  }
+  const OIIO::ImageSpec spec = input->spec();
+  if (spec.deep) throw Error("cannot read " + quoted(path) + ": deep images are not supported");
+  if (spec.depth > 1) throw Error("cannot read " + quoted(path) + ": volume images are not supported");
+  if (spec.x != spec.full_x || spec.y != spec.full_y || spec.width != spec.full_width ||
+      spec.height != spec.full_height) {
+    throw Error("cannot read " + quoted(path) + ": its data window (" + std::to_string(spec.width) +
+                " x " + std::to_string(spec.height) + " at " + std::to_string(spec.x) + ", " +
+                std::to_string(spec.y) + ") differs from its display window (" +
+                std::to_string(spec.full_width) + " x " + std::to_string(spec.full_height) +
+                "); crop or pad it to the full frame first");
+  }
+
+  Image image;
+  image.width = spec.width;
+  image.height = spec.height;
+  const size_t count = checked_float_count(spec.width, spec.height, spec.nchannels, path);
+  for (int c = 0; c < spec.nchannels; ++c) image.channel_names.push_back(spec.channel_name(c));
+  try {
+    image.pixels.resize(count);
+  } catch (const std::bad_alloc&) {
+    throw Error("cannot read " + quoted(path) + ": out of memory for " +
+                std::to_string(spec.width) + " x " + std::to_string(spec.height) + " x " +
+                std::to_string(spec.nchannels) + " floats");
+  }
+  const bool ok = input->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT,
+                                    image.pixels.data());
+  const std::string error = input->geterror();
+  input->close();
+  if (!ok) {
+    throw Error("cannot read " + quoted(path) + ": the file is truncated or corrupt (" +
+                oiio_detail(error) + ")");
+  }
+  return image;
+}
+
+int require_channel(const Image& image, const std::string& name, const std::string& path) {
+  const int index = image.find_channel(name);
+  if (index < 0) {
+    throw Error(quoted(path) + " has no channel " + quoted(name) + "; its channels are: " +
+                join_names(image.channel_names));
+  }
+  return index;
+}
+
+std::vector<float> extract_channels(const Image& image, const std::vector<int>& indices) {
+  const size_t n = indices.size();
+  const size_t stride = static_cast<size_t>(image.channels());
+  std::vector<float> out(image.pixel_count() * n);
+  for (size_t p = 0; p < image.pixel_count(); ++p) {
+    for (size_t k = 0; k < n; ++k) {
+      out[p * n + k] = image.pixels[p * stride + static_cast<size_t>(indices[k])];
+    }
+  }
+  return out;
+}
+
+void write_exr(const std::string& path, int width, int height,
+               const std::vector<std::string>& channel_names, const std::vector<float>& pixels) {
+  const int channels = static_cast<int>(channel_names.size());
+  if (width <= 0 || height <= 0 || channels <= 0) {
+    throw Error("cannot write " + quoted(path) + ": empty image (" + std::to_string(width) +
+                " x " + std::to_string(height) + " x " + std::to_string(channels) + " channels)");
+  }
+  if (pixels.size() != checked_float_count(width, height, channels, path)) {
+    throw Error("cannot write " + quoted(path) + ": internal error: pixel buffer has " +
+                std::to_string(pixels.size()) + " floats for " + std::to_string(width) + " x " +
+                std::to_string(height) + " x " + std::to_string(channels));
+  }
+  if (fs::is_directory(path)) throw Error("cannot write " + quoted(path) + ": it is a directory");
+
+  OIIO::ImageSpec spec(width, height, channels, OIIO::TypeDesc::FLOAT);
+  spec.channelnames = channel_names;
+  spec.alpha_channel = -1;
+  for (int c = 0; c < channels; ++c) {
+    if (channel_names[static_cast<size_t>(c)] == "A") spec.alpha_channel = c;
+  }
+  spec.attribute("compression", "zip");
+
+  TemporaryFile temporary(path);
+  auto output = OIIO::ImageOutput::create("openexr");
+  if (!output) {
+    throw Error("cannot write " + quoted(path) + ": no OpenEXR writer (" +
+                oiio_detail(OIIO::geterror()) + ")");
+  }
+  bool ok = output->open(temporary.path(), spec) &&
+            output->write_image(OIIO::TypeDesc::FLOAT, pixels.data());
+  ok = output->close() && ok;
+  if (!ok) {
+    throw Error("cannot write " + quoted(path) + ": " + oiio_detail(output->geterror()));
+  }
+  temporary.commit(path);
+}
+
+}  // namespace ssao_io

@@ -1,0 +1,52 @@
+// SPDX-License-Identifier: MIT
+// Float image files through OpenImageIO: read any OIIO-readable file (EXR first of all) into
+// interleaved float pixels, write OpenEXR atomically. OpenImageIO stays out of this header.
+#pragma once
+
+#include <cstddef>
+#include <string>
+#include <vector>
+
+#include "io/error.h"
+
+namespace ssao_io {
+
+// A whole image in memory: pixel (x, y), y = 0 the TOP row, channel c is
+// pixels[(y * width + x) * channels() + c].
+struct Image {
+  int width = 0;
+  int height = 0;
+  std::vector<std::string> channel_names;
+  std::vector<float> pixels;
+
+  int channels() const { return static_cast<int>(channel_names.size()); }
+  size_t pixel_count() const { return static_cast<size_t>(width) * static_cast<size_t>(height); }
+
+  // Index of the channel called exactly `name`, or -1.
+  int find_channel(const std::string& name) const;
+};
+
+// Reads the first subimage of `path` as 32-bit float. Throws Error for a missing file, a file
+// that is not an image OIIO can read, a truncated or corrupt file (OIIO's message included), a
+// deep image, or a data window that differs from the display window.
+Image read_image(const std::string& path);
+
+// Index of channel `name` in `image` (read from `path`, used in the message); throws Error
+// listing the channels that do exist when there is none.
+int require_channel(const Image& image, const std::string& name, const std::string& path);
+
+// Copies the channels `indices` (in that order) of every pixel into a tightly packed buffer
+// of width * height * indices.size() floats.
+std::vector<float> extract_channels(const Image& image, const std::vector<int>& indices);
+
+// Writes `pixels` (interleaved, top row first, channel_names.size() channels) as a 32-bit float,
+// ZIP-compressed OpenEXR file, whatever the extension of `path`. The data go to a temporary
+// file in the same folder, which is renamed to `path` only once complete, so a failed write
+// never leaves a partial file under the final name. Throws Error on failure.
+void write_exr(const std::string& path, int width, int height,
+               const std::vector<std::string>& channel_names, const std::vector<float>& pixels);
+
+// Comma-separated list of the names, for messages: "R, G, B".
+std::string join_names(const std::vector<std::string>& names, const char* separator = ", ");
+
+}  // namespace ssao_io

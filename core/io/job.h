@@ -1,0 +1,110 @@
+// SPDX-License-Identifier: MIT
+// A small RAII wrapper over the C API for front ends: ssao_io::Job owns an ssao_job, and every
+// call throws ssao_io::Error carrying ssao_last_error() when the core does not return SSAO_OK.
+// Header-only: it uses nothing but ssao/ssao.h.
+#pragma once
+
+#include <cstddef>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "io/error.h"
+#include "ssao/ssao.h"
+
+namespace ssao_io {
+
+// The error raised for a non-OK status: its status code is kept for callers that care.
+class CoreError : public Error {
+ public:
+  CoreError(ssao_status status, const std::string& message) : Error(message), status_(status) {}
+  ssao_status status() const { return status_; }
+
+ private:
+  ssao_status status_;
+};
+
+// Throws CoreError("<what>: <ssao_last_error()>") unless status is SSAO_OK.
+inline void check_status(ssao_status status, const std::string& what) {
+  if (status == SSAO_OK) return;
+  std::string detail = ssao_last_error();
+  if (detail.empty()) detail = ssao_status_string(status);
+  throw CoreError(status, what.empty() ? detail : what + ": " + detail);
+}
+
+// Every parameter of the core, in table order.
+inline std::vector<ssao_param_desc> param_table() {
+  std::vector<ssao_param_desc> table(ssao_param_count());
+  for (size_t i = 0; i < table.size(); ++i) check_status(ssao_param_info(i, &table[i]), "");
+  return table;
+}
+
+// "0.1.0" from ssao_version().
+inline std::string version_string(int version) {
+  return std::to_string(version / 10000) + "." + std::to_string(version / 100 % 100) + "." +
+         std::to_string(version % 100);
+}
+
+class Job {
+ public:
+  Job() { check_status(ssao_job_create(&job_), "cannot create an SSAO job"); }
+  ~Job() { ssao_job_destroy(job_); }
+  Job(const Job&) = delete;
+  Job& operator=(const Job&) = delete;
+  Job(Job&& other) noexcept : job_(std::exchange(other.job_, nullptr)) {}
+  Job& operator=(Job&& other) noexcept {
+    std::swap(job_, other.job_);
+    return *this;
+  }
+
+  ssao_job get() const { return job_; }
+
+  void set(const std::string& name, int value) {
+    check_status(ssao_job_set_int(job_, name.c_str(), value), "parameter " + name);
+  }
+  void set(const std::string& name, double value) {
+    check_status(ssao_job_set_float(job_, name.c_str(), value), "parameter " + name);
+  }
+  void set(const std::string& name, const std::string& value) {
+    check_status(ssao_job_set_string(job_, name.c_str(), value.c_str()), "parameter " + name);
+  }
+  void set(const std::string& name, const char* value) { set(name, std::string(value)); }
+  void set(const std::string& name, const std::vector<double>& values) {
+    check_status(ssao_job_set_floats(job_, name.c_str(), values.data(), values.size()),
+                 "parameter " + name);
+  }
+
+  int get_int(const std::string& name) const {
+    int value = 0;
+    check_status(ssao_job_get_int(job_, name.c_str(), &value), "parameter " + name);
+    return value;
+  }
+  double get_float(const std::string& name) const {
+    double value = 0.0;
+    check_status(ssao_job_get_float(job_, name.c_str(), &value), "parameter " + name);
+    return value;
+  }
+  std::string get_string(const std::string& name) const {
+    char buffer[256] = {};
+    check_status(ssao_job_get_string(job_, name.c_str(), buffer, sizeof buffer),
+                 "parameter " + name);
+    return buffer;
+  }
+
+  // Attaches a caller-owned image (see ssao_job_set_image); strides in bytes, 0 = packed.
+  void set_image(const std::string& name, float* data, int width, int height, int channels,
+                 std::ptrdiff_t pixel_stride = 0, std::ptrdiff_t row_stride = 0) {
+    check_status(ssao_job_set_image(job_, name.c_str(), data, width, height, channels,
+                                    pixel_stride, row_stride),
+                 "image " + name);
+  }
+  void set_progress(ssao_progress_fn fn, void* user) {
+    check_status(ssao_job_set_progress(job_, fn, user), "progress callback");
+  }
+  void run() { check_status(ssao_job_run(job_), "SSAO failed"); }
+
+ private:
+  ssao_job job_ = nullptr;
+};
+
+}  // namespace ssao_io

@@ -1,0 +1,153 @@
+// SPDX-License-Identifier: MIT
+// The C boundary: every entry point checks its handle, calls into C++, and turns exceptions into
+// a status plus a per-thread message. Nothing else in the library knows about C.
+#include <cstring>
+#include <new>
+#include <string>
+
+#include "error.h"
+#include "job.h"
+#include "params.h"
+#include "ssao/ssao.h"
+
+namespace {
+
+thread_local std::string last_error;
+
+ssao_status fail(ssao_status status, const char* message) {
+  last_error = message;
+  return status;
+}
+
+template <typename Fn>
+ssao_status guarded(Fn&& fn) {
+  try {
+    fn();
+    return SSAO_OK;
+  } catch (const ssao::Error& e) {
+    return fail(e.status(), e.what());
+  } catch (const std::bad_alloc&) {
+    return fail(SSAO_ERROR_OUT_OF_MEMORY, "out of memory");
+  } catch (const std::exception& e) {
+    return fail(SSAO_ERROR_INTERNAL, e.what());
+  } catch (...) {
+    return fail(SSAO_ERROR_INTERNAL, "unknown internal error");
+  }
+}
+
+ssao::Job& checked(ssao_job job) {
+  if (job == nullptr) ssao::throw_invalid_argument("job handle is NULL");
+  return *job;
+}
+
+}  // namespace
+
+extern "C" {
+
+SSAO_API int ssao_version(void) { return SSAO_VERSION; }
+
+SSAO_API const char* ssao_status_string(ssao_status status) {
+  switch (status) {
+    case SSAO_OK: return "success";
+    case SSAO_ERROR_INVALID_ARGUMENT: return "invalid argument";
+    case SSAO_ERROR_INVALID_OPERATION: return "invalid operation";
+    case SSAO_ERROR_OUT_OF_MEMORY: return "out of memory";
+    case SSAO_ERROR_CANCELLED: return "cancelled";
+    case SSAO_ERROR_INTERNAL: return "internal error";
+  }
+  return "unknown status";
+}
+
+SSAO_API const char* ssao_last_error(void) { return last_error.c_str(); }
+
+SSAO_API size_t ssao_param_count(void) { return ssao::param_count(); }
+
+SSAO_API ssao_status ssao_param_info(size_t index, ssao_param_desc* out) {
+  return guarded([&] {
+    if (out == nullptr) ssao::throw_invalid_argument("output pointer is NULL");
+    *out = ssao::param_desc(index);
+  });
+}
+
+SSAO_API ssao_status ssao_job_create(ssao_job* out) {
+  return guarded([&] {
+    if (out == nullptr) ssao::throw_invalid_argument("output pointer is NULL");
+    *out = nullptr;
+    *out = new ssao_job_impl();
+  });
+}
+
+SSAO_API void ssao_job_destroy(ssao_job job) { delete job; }
+
+SSAO_API ssao_status ssao_job_set_int(ssao_job job, const char* name, int value) {
+  return guarded([&] { checked(job).params().set_int(name, value); });
+}
+
+SSAO_API ssao_status ssao_job_set_float(ssao_job job, const char* name, double value) {
+  return guarded([&] { checked(job).params().set_float(name, value); });
+}
+
+SSAO_API ssao_status ssao_job_set_string(ssao_job job, const char* name, const char* value) {
+  return guarded([&] { checked(job).params().set_string(name, value); });
+}
+
+SSAO_API ssao_status ssao_job_set_floats(ssao_job job, const char* name, const double* values,
+                                         size_t count) {
+  return guarded([&] { checked(job).params().set_floats(name, values, count); });
+}
+
+SSAO_API ssao_status ssao_job_get_int(ssao_job job, const char* name, int* out) {
+  return guarded([&] {
+    if (out == nullptr) ssao::throw_invalid_argument("output pointer is NULL");
+    *out = checked(job).params().get_int(name);
+  });
+}
+
+SSAO_API ssao_status ssao_job_get_float(ssao_job job, const char* name, double* out) {
+  return guarded([&] {
+    if (out == nullptr) ssao::throw_invalid_argument("output pointer is NULL");
+    *out = checked(job).params().get_float(name);
+  });
+}
+
+SSAO_API ssao_status ssao_job_get_string(ssao_job job, const char* name, char* out, size_t size) {
+  return guarded([&] {
+    if (out == nullptr || size == 0) ssao::throw_invalid_argument("output buffer is NULL or empty");
+    const std::string& value = checked(job).params().get_string(name);
+    const size_t n = std::min(size - 1, value.size());
+    std::memcpy(out, value.data(), n);
+    out[n] = '\0';
+  });
+}
+
+SSAO_API ssao_status ssao_job_get_floats(ssao_job job, const char* name, double* out,
+                                         size_t count) {
+  return guarded([&] {
+    if (out == nullptr) ssao::throw_invalid_argument("output pointer is NULL");
+    const std::vector<double>& values = checked(job).params().get_floats(name);
+    if (count != values.size()) {
+      ssao::throw_invalid_argument(std::string("parameter '") + name + "' has " +
+                                   std::to_string(values.size()) + " values, not " +
+                                   std::to_string(count));
+    }
+    std::copy(values.begin(), values.end(), out);
+  });
+}
+
+SSAO_API ssao_status ssao_job_set_image(ssao_job job, const char* name, float* data, int width,
+                                        int height, int channels, ptrdiff_t pixel_stride,
+                                        ptrdiff_t row_stride) {
+  return guarded([&] {
+    checked(job).set_image(name, data, width, height, channels, pixel_stride, row_stride);
+  });
+}
+
+SSAO_API ssao_status ssao_job_set_progress(ssao_job job, ssao_progress_fn fn, void* user) {
+  return guarded([&] { checked(job).set_progress(fn, user); });
+}
+
+SSAO_API ssao_status ssao_job_run(ssao_job job) {
+  return guarded([&] { checked(job).run(); });
+}
+
+}  // extern "C"

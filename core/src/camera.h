@@ -1,0 +1,74 @@
+// SPDX-License-Identifier: MIT
+// Pixel <-> view-space mapping of a Blender-style camera (perspective or orthographic, sensor
+// fit, lens shift, pixel aspect). Pixel (px, py) has its centre at (px + 0.5, py + 0.5) in
+// continuous image coordinates, with py = 0 the top row. View space looks down -Z, +Y up.
+#pragma once
+
+#include <string>
+
+#include "vec3.h"
+
+namespace ssao {
+
+struct CameraParams {
+  bool orthographic = false;
+  double lens = 50.0;           // mm
+  double sensor_width = 36.0;   // mm
+  double sensor_height = 24.0;  // mm
+  std::string sensor_fit = "AUTO";
+  double shift_x = 0.0, shift_y = 0.0;  // in units of the fitted image side
+  double ortho_scale = 6.0;
+  double pixel_aspect_x = 1.0, pixel_aspect_y = 1.0;
+};
+
+class CameraModel {
+ public:
+  // Mirrors Blender's viewplane computation (BKE_camera_params_compute_viewplane).
+  CameraModel(const CameraParams& params, int width, int height);
+
+  bool orthographic() const { return orthographic_; }
+
+  // View-space position of the point at planar depth d seen through continuous image
+  // coordinates (u, v).
+  Vec3 view_position(float u, float v, float planar_depth) const {
+    const float x = (u - center_u_) * scale_u_;
+    const float y = (center_v_ - v) * scale_v_;
+    if (orthographic_) return {x, y, -planar_depth};
+    return {x * planar_depth, y * planar_depth, -planar_depth};
+  }
+
+  // Continuous image coordinates of a view-space point; false if it is not in front of the
+  // camera (perspective).
+  bool project(Vec3 p, float& u, float& v) const {
+    float x = p.x, y = p.y;
+    if (!orthographic_) {
+      const float d = -p.z;
+      if (!(d > 0.0f)) return false;
+      x /= d;
+      y /= d;
+    }
+    u = x / scale_u_ + center_u_;
+    v = center_v_ - y / scale_v_;
+    return true;
+  }
+
+  // Length of the ray to the pixel centre per unit of planar depth: radial = planar * factor.
+  float radial_factor(float u, float v) const;
+
+  // Direction from the point towards the camera (unit), for orienting normals.
+  Vec3 towards_camera(Vec3 p) const {
+    return orthographic_ ? Vec3{0.0f, 0.0f, 1.0f} : normalize_or(-p, Vec3{0.0f, 0.0f, 1.0f});
+  }
+
+  // Width in view units of one pixel at planar depth d.
+  float pixel_footprint(float planar_depth) const {
+    return orthographic_ ? scale_u_ : scale_u_ * planar_depth;
+  }
+
+ private:
+  bool orthographic_ = false;
+  float scale_u_ = 1.0f, scale_v_ = 1.0f;    // view units per pixel (at unit depth if PERSP)
+  float center_u_ = 0.0f, center_v_ = 0.0f;  // principal point in continuous image coordinates
+};
+
+}  // namespace ssao

@@ -1,0 +1,209 @@
+// SPDX-License-Identifier: MIT
+#include "job.h"
+
+#include <cmath>
+#include <cstring>
+#include <limits>
+#include <vector>
+
+#include "camera.h"
+#include "denoise.h"
+#include "error.h"
+#include "gbuffer.h"
+#include "kernels.h"
+#include "variants.h"
+
+namespace ssao {
+namespace {
+
+struct ImageRule {
+  const char* name;
+  int min_channels, max_channels;
+};
+constexpr ImageRule kImageRules[] = {
+    {"depth", 1, 4}, {"normal", 3, 4}, {"beauty", 1, 4}, {"ao", 1, 4}, {"composite", 1, 4}};
+
+CameraParams camera_params(const ParamValues& v) {
+  CameraParams c;
+  c.orthographic = v.get_string("camera_type") == "ORTHO";
+  c.lens = v.get_float("lens");
+  c.sensor_width = v.get_float("sensor_width");
+  c.sensor_height = v.get_float("sensor_height");
+  c.sensor_fit = v.get_string("sensor_fit");
+  c.shift_x = v.get_float("shift_x");
+  c.shift_y = v.get_float("shift_y");
+  c.ortho_scale = v.get_float("ortho_scale");
+  c.pixel_aspect_x = v.get_float("pixel_aspect_x");
+  c.pixel_aspect_y = v.get_float("pixel_aspect_y");
+  return c;
+}
+
+DenoiseMode denoise_mode(const std::string& name) {
+  if (name == "none") return DenoiseMode::none;
+  if (name == "box4") return DenoiseMode::box4;
+  return DenoiseMode::bilateral;
+}
+
+// Final AO from raw visibility: power, then strength, then the optional min/max remap.
+struct Shaping {
+  float power, strength, remap_min, remap_max;
+  float apply(float visibility) const {
+    const float shaped = power == 1.0f ? visibility : std::pow(visibility, power);
+    const float strong = 1.0f - strength * (1.0f - shaped);
+    return saturate(remap_min + (remap_max - remap_min) * strong);
+  }
+};
+
+}  // namespace
+
+void Job::set_image(const char* name, float* data, int width, int height, int channels,
+                    std::ptrdiff_t pixel_stride, std::ptrdiff_t row_stride) {
+  if (name == nullptr) throw_invalid_argument("image name is NULL");
+  const ImageRule* rule = nullptr;
+  for (const ImageRule& r : kImageRules) {
+    if (std::strcmp(r.name, name) == 0) rule = &r;
+  }
+  if (rule == nullptr) {
+    throw_invalid_argument(std::string("unknown image '") + name +
+                           "' (expected depth, normal, beauty, ao or composite)");
+  }
+  ImageView* slot = std::strcmp(name, "depth") == 0    ? &depth_
+                    : std::strcmp(name, "normal") == 0 ? &normal_
+                    : std::strcmp(name, "beauty") == 0 ? &beauty_
+                    : std::strcmp(name, "ao") == 0     ? &ao_out_
+                                                       : &composite_out_;
+  if (data == nullptr) {
+    *slot = ImageView{};
+    return;
+  }
+  const std::string what = std::string("image '") + name + "': ";
+  if (width < 0 || height < 0) throw_invalid_argument(what + "negative width or height");
+  if (channels < rule->min_channels || channels > rule->max_channels) {
+    throw_invalid_argument(what + "needs " + std::to_string(rule->min_channels) + " to " +
+                           std::to_string(rule->max_channels) + " channels, got " +
+                           std::to_string(channels));
+  }
+  const std::ptrdiff_t pixel_bytes = std::ptrdiff_t(channels) * std::ptrdiff_t(sizeof(float));
+  if (pixel_stride == 0) pixel_stride = pixel_bytes;
+  if (pixel_stride < pixel_bytes) {
+    throw_invalid_argument(what + "pixel stride " + std::to_string(pixel_stride) +
+                           " is smaller than one pixel (" + std::to_string(pixel_bytes) +
+                           " bytes)");
+  }
+  if (pixel_stride % std::ptrdiff_t(sizeof(float)) != 0) {
+    throw_invalid_argument(what + "pixel stride must be a multiple of 4 bytes");
+  }
+  if (row_stride == 0) row_stride = pixel_stride * width;
+  const std::ptrdiff_t row_bytes = pixel_stride * width;
+  if (std::abs(row_stride) < row_bytes || row_stride % std::ptrdiff_t(sizeof(float)) != 0) {
+    throw_invalid_argument(what + "row stride " + std::to_string(row_stride) +
+                           " is not a multiple of 4 of at least one row (" +
+                           std::to_string(row_bytes) + " bytes)");
+  }
+  if (reinterpret_cast<std::uintptr_t>(data) % alignof(float) != 0) {
+    throw_invalid_argument(what + "data is not aligned to 4 bytes");
+  }
+  *slot = ImageView{data, width, height, channels, pixel_stride, row_stride};
+}
+
+void Job::validate_images() const {
+  if (!depth_.attached()) throw_invalid_operation("no depth image: attach one with set_image");
+  if (!ao_out_.attached() && !composite_out_.attached()) {
+    throw_invalid_operation("no output image: attach 'ao' or 'composite'");
+  }
+  const std::pair<const char*, const ImageView*> others[] = {
+      {"normal", &normal_}, {"beauty", &beauty_}, {"ao", &ao_out_}, {"composite", &composite_out_}};
+  for (const auto& [name, view] : others) {
+    if (view->attached() && (view->width != depth_.width || view->height != depth_.height)) {
+      throw_invalid_argument(std::string("image '") + name + "' is " + std::to_string(view->width) +
+                             "x" + std::to_string(view->height) + " but depth is " +
+                             std::to_string(depth_.width) + "x" + std::to_string(depth_.height));
+    }
+  }
+  if (composite_out_.attached()) {
+    if (!beauty_.attached()) throw_invalid_operation("'composite' output needs a 'beauty' image");
+    if (composite_out_.channels != beauty_.channels) {
+      throw_invalid_argument("'composite' has " + std::to_string(composite_out_.channels) +
+                             " channels but 'beauty' has " + std::to_string(beauty_.channels));
+    }
+  }
+}
+
+void Job::run() {
+  validate_images();
+  const int width = depth_.width, height = depth_.height;
+  if (width == 0 || height == 0) return;
+
+  const ParamValues& v = params_;
+  const CameraModel camera(camera_params(v), width, height);
+  const int threads = resolve_thread_count(v.get_int("threads"));
+  Progress progress(progress_callback_, progress_user_);
+
+  GBufferInputs in;
+  in.depth = depth_;
+  in.normal = normal_;
+  in.radial_depth = v.get_string("depth_kind") == "radial";
+  in.world_normals = v.get_string("normal_space") == "world";
+  const std::vector<double>& matrix = v.get_floats("camera_to_world");
+  std::copy(matrix.begin(), matrix.end(), in.camera_to_world);
+  in.background_depth = static_cast<float>(
+      std::min(v.get_float("background_depth"), double(std::numeric_limits<float>::max())));
+  in.clip_end = static_cast<float>(
+      std::min(v.get_float("clip_end"), double(std::numeric_limits<float>::max())));
+
+  progress.set_stage(0.0, 0.1);
+  GBuffer gbuffer(camera, width, height);
+  gbuffer.build(in, threads, progress);
+
+  VariantSettings settings;
+  settings.radius = static_cast<float>(v.get_float("radius"));
+  settings.bias = static_cast<float>(v.get_float("bias"));
+  settings.clustering = static_cast<float>(v.get_float("sample_clustering"));
+  settings.steps = v.get_int("steps");
+  settings.thickness = static_cast<float>(v.get_float("thickness"));
+  settings.seed = static_cast<uint32_t>(v.get_int("seed"));
+  settings.sphere_normalized = v.get_string("sphere_mode") == "normalized";
+  const bool sphere = v.get_string("variant") == "sphere";
+  const int samples = v.get_int("samples");
+  const Kernel kernel = sphere ? make_sphere_kernel(samples) : make_hemisphere_kernel(samples);
+
+  progress.set_stage(0.1, 0.9);
+  std::vector<float> visibility(size_t(width) * size_t(height), 1.0f);
+  parallel_rows(height, threads, progress, [&](int y) {
+    float* row = visibility.data() + size_t(y) * width;
+    if (sphere) {
+      sphere_row(gbuffer, kernel, settings, y, row);
+    } else {
+      hemisphere_row(gbuffer, kernel, settings, y, row);
+    }
+  });
+
+  progress.set_stage(0.9, 1.0);
+  visibility = denoise(gbuffer, visibility, denoise_mode(v.get_string("denoise")),
+                       settings.radius, threads, progress);
+
+  // Outputs are written only now, after every stage succeeded: a failed or cancelled run leaves
+  // the caller's buffers untouched.
+  const Shaping shaping{static_cast<float>(v.get_float("power")),
+                        static_cast<float>(v.get_float("strength")),
+                        static_cast<float>(v.get_float("remap_min")),
+                        static_cast<float>(v.get_float("remap_max"))};
+  for (int y = 0; y < height; ++y) {
+    for (int x = 0; x < width; ++x) {
+      const size_t i = size_t(y) * width + x;
+      const float ao = gbuffer.is_geometry(x, y) ? shaping.apply(visibility[i]) : 1.0f;
+      if (ao_out_.attached()) {
+        float* out = ao_out_.pixel(x, y);
+        for (int c = 0; c < std::min(ao_out_.channels, 3); ++c) out[c] = ao;
+        if (ao_out_.channels == 4) out[3] = 1.0f;
+      }
+      if (composite_out_.attached()) {
+        const float* src = beauty_.pixel(x, y);
+        float* dst = composite_out_.pixel(x, y);
+        for (int c = 0; c < composite_out_.channels; ++c) dst[c] = c < 3 ? src[c] * ao : src[c];
+      }
+    }
+  }
+}
+
+}  // namespace ssao

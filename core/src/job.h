@@ -1,0 +1,39 @@
+// SPDX-License-Identifier: MIT
+// One AO job: parameter values, attached images, and the run pipeline
+// (geometry -> variant -> denoise -> shaping -> outputs).
+#pragma once
+
+#include <string>
+
+#include "image_view.h"
+#include "params.h"
+#include "parallel.h"
+
+namespace ssao {
+
+class Job {
+ public:
+  ParamValues& params() { return params_; }
+  const ParamValues& params() const { return params_; }
+
+  void set_image(const char* name, float* data, int width, int height, int channels,
+                 std::ptrdiff_t pixel_stride, std::ptrdiff_t row_stride);
+  void set_progress(Progress::Callback callback, void* user) {
+    progress_callback_ = callback;
+    progress_user_ = user;
+  }
+  void run();
+
+ private:
+  void validate_images() const;
+
+  ParamValues params_;
+  ImageView depth_, normal_, beauty_, ao_out_, composite_out_;
+  Progress::Callback progress_callback_ = nullptr;
+  void* progress_user_ = nullptr;
+};
+
+}  // namespace ssao
+
+// The C handle type is the job itself.
+struct ssao_job_impl : ssao::Job {};

@@ -1,0 +1,41 @@
+// SPDX-License-Identifier: MIT
+// The parameter table (the single source of names, defaults, ranges and units) and a job's
+// current values. settings.h turns the values into typed settings for one run.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "ssao/ssao.h"
+
+namespace ssao {
+
+size_t param_count();
+const ssao_param_desc& param_desc(size_t index);
+
+// Current values of every parameter of one job, validated on every set.
+class ParamValues {
+ public:
+  ParamValues();
+
+  void set_int(const char* name, int value);
+  void set_float(const char* name, double value);
+  void set_string(const char* name, const char* value);
+  void set_floats(const char* name, const double* values, size_t count);
+
+  int get_int(const char* name) const;
+  double get_float(const char* name) const;
+  const std::string& get_string(const char* name) const;
+  const std::vector<double>& get_floats(const char* name) const;
+
+ private:
+  struct Value {
+    double number = 0.0;
+    std::string text;
+    std::vector<double> floats;
+  };
+  size_t index_of(const char* name, ssao_param_type expected) const;
+  std::vector<Value> values_;
+};
+
+}  // namespace ssao

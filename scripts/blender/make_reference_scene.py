@@ -1,0 +1,448 @@
+"""Build a small test scene in Blender and render a ray-traced reference.
+
+Writes, for ``--out PREFIX``:
+
+* ``PREFIX.exr``          OpenEXR multilayer, 32-bit float, ZIP: the passes
+                          ``ViewLayer.Combined.{R,G,B,A}``, ``ViewLayer.Depth.Z``,
+                          ``ViewLayer.Normal.{X,Y,Z}`` and, unless ``--no-ao-pass``,
+                          ``ViewLayer.AO.{R,G,B}`` (Cycles' ray-traced ambient
+                          occlusion within ``--ao-distance``: the ground truth).
+* ``PREFIX.camera.json``  the camera, in the format of docs/conventions.md.
+* ``PREFIX.json``         render metadata (size, samples, ao_distance, timing,
+                          Blender version, and Blender's own projection matrix).
+
+The scene is built from scratch: a floor and a back wall meeting at a right
+angle (a concave corner), a box touching the wall, two stacked boxes, a
+rotated box and a sphere resting on the floor, all plain grey diffuse, lit by
+a sun, seen by a rotated camera that shows a strip of sky.
+
+Run (Blender 3.4 and 4.x):
+
+    blender -b --factory-startup -noaudio --python-exit-code 1 \\
+        -P scripts/blender/make_reference_scene.py -- --out /tmp/ref/scene
+
+Only Cycles on the CPU is supported for now; the engine is chosen through
+``ENGINES`` so that another one (EEVEE) can be added next to it.
+"""
+
+import argparse
+import json
+import math
+import os
+import sys
+import time
+import traceback
+
+import bpy
+import bmesh
+from mathutils import Euler, Matrix, Vector
+
+VIEW_LAYER_NAME = "ViewLayer"
+
+# Scene layout, in metres, Z up. The floor is z = 0, the back wall is the
+# plane y = WALL_Y facing -Y; they share the edge y = WALL_Y, z = 0.
+FLOOR_X = (-7.0, 5.0)
+FLOOR_Y = (-7.0, 2.0)
+WALL_Y = 2.0
+WALL_HEIGHT = 2.0
+
+# Camera: rotated about Z (not looking along an axis) and tilted down.
+CAMERA_LOCATION = Vector((2.7, -4.3, 2.2))
+CAMERA_TARGET = Vector((-0.2, 0.6, 0.75))
+CAMERA_LENS = 35.0
+CAMERA_SENSOR_WIDTH = 36.0
+CAMERA_CLIP = (0.1, 100.0)
+
+GREY = (0.6, 0.6, 0.6, 1.0)
+WORLD_COLOR = (0.45, 0.55, 0.75, 1.0)
+
+
+# ---------------------------------------------------------------------------
+# Command line
+
+def parse_args(argv):
+    parser = argparse.ArgumentParser(
+        prog="make_reference_scene.py",
+        description="Render the test scene with Blender into PREFIX.exr, "
+                    "PREFIX.camera.json and PREFIX.json.")
+    parser.add_argument("--out", required=True,
+                        help="output prefix (writes PREFIX.exr, PREFIX.camera.json, PREFIX.json)")
+    parser.add_argument("--width", type=int, default=160)
+    parser.add_argument("--height", type=int, default=90)
+    parser.add_argument("--samples", type=int, default=256,
+                        help="samples per pixel (default 256)")
+    parser.add_argument("--ao-distance", type=float, default=0.8,
+                        help="AO ray length, world.light_settings.distance (default 0.8)")
+    parser.add_argument("--camera", choices=("persp", "ortho"), default="persp")
+    parser.add_argument("--engine", choices=sorted(ENGINES), default="cycles")
+    parser.add_argument("--threads", type=int, default=2)
+    parser.add_argument("--seed", type=int, default=1, help="Cycles seed (default 1)")
+    parser.add_argument("--no-ao-pass", action="store_true",
+                        help="do not render the AO pass (for a small sample image)")
+    parser.add_argument("--scene-name", default=None,
+                        help="name stored in the metadata (default: basename of --out)")
+    args = parser.parse_args(argv)
+    if args.width < 1 or args.height < 1:
+        parser.error("--width and --height must be positive")
+    if args.samples < 1:
+        parser.error("--samples must be positive")
+    if not args.ao_distance > 0.0:
+        parser.error("--ao-distance must be positive")
+    if args.threads < 1:
+        parser.error("--threads must be positive")
+    if "#" in os.path.basename(args.out):
+        parser.error("--out must not contain '#' (Blender reads it as a frame number)")
+    return args
+
+
+def script_argv():
+    """The arguments after '--' (Blender's own arguments come before it)."""
+    if "--" in sys.argv:
+        return sys.argv[sys.argv.index("--") + 1:]
+    return []
+
+
+# ---------------------------------------------------------------------------
+# Scene construction
+
+def clear_scene(scene):
+    """Remove every object (and its data) that the startup file put there."""
+    for obj in list(scene.objects):
+        bpy.data.objects.remove(obj, do_unlink=True)
+    for collection in (bpy.data.meshes, bpy.data.cameras, bpy.data.lights,
+                       bpy.data.materials):
+        for block in list(collection):
+            if block.users == 0:
+                collection.remove(block)
+
+
+def grey_material():
+    mat = bpy.data.materials.new("Grey")
+    mat.use_nodes = True
+    nodes = mat.node_tree.nodes
+    nodes.clear()
+    bsdf = nodes.new("ShaderNodeBsdfDiffuse")
+    bsdf.inputs["Color"].default_value = GREY
+    out = nodes.new("ShaderNodeOutputMaterial")
+    mat.node_tree.links.new(bsdf.outputs["BSDF"], out.inputs["Surface"])
+    mat.diffuse_color = GREY
+    return mat
+
+
+def add_mesh_object(scene, name, verts, faces, material, smooth=False):
+    mesh = bpy.data.meshes.new(name)
+    mesh.from_pydata([tuple(v) for v in verts], [], faces)
+    mesh.validate()
+    mesh.update()
+    for poly in mesh.polygons:
+        poly.use_smooth = smooth
+    mesh.materials.append(material)
+    obj = bpy.data.objects.new(name, mesh)
+    scene.collection.objects.link(obj)
+    return obj
+
+
+def add_quad(scene, name, corners, material):
+    """A single quad; corners are given counter-clockwise seen from the front."""
+    return add_mesh_object(scene, name, corners, [(0, 1, 2, 3)], material)
+
+
+def add_box(scene, name, size, center, material, rotation_z_deg=0.0):
+    """An axis-aligned box of size (sx, sy, sz), rotated about Z, at center."""
+    sx, sy, sz = (0.5 * s for s in size)
+    verts = [Vector((x, y, z)) for z in (-sz, sz) for y in (-sy, sy) for x in (-sx, sx)]
+    # Vertex index = ix + 2*iy + 4*iz. Faces wound counter-clockwise seen from outside.
+    faces = [
+        (0, 2, 3, 1),  # bottom (-Z)
+        (4, 5, 7, 6),  # top (+Z)
+        (0, 1, 5, 4),  # front (-Y)
+        (2, 6, 7, 3),  # back (+Y)
+        (0, 4, 6, 2),  # left (-X)
+        (1, 3, 7, 5),  # right (+X)
+    ]
+    rot = Matrix.Rotation(math.radians(rotation_z_deg), 3, "Z")
+    verts = [rot @ v + Vector(center) for v in verts]
+    return add_mesh_object(scene, name, verts, faces, material)
+
+
+def add_sphere(scene, name, radius, center, material, segments=48, rings=24):
+    mesh = bpy.data.meshes.new(name)
+    bm = bmesh.new()
+    # bmesh's create_uvsphere takes 'radius' since Blender 3.0 ('diameter' before).
+    bmesh.ops.create_uvsphere(bm, u_segments=segments, v_segments=rings, radius=radius)
+    bmesh.ops.translate(bm, vec=Vector(center), verts=bm.verts)
+    bm.to_mesh(mesh)
+    bm.free()
+    for poly in mesh.polygons:
+        poly.use_smooth = True
+    mesh.materials.append(material)
+    obj = bpy.data.objects.new(name, mesh)
+    scene.collection.objects.link(obj)
+    return obj
+
+
+def build_geometry(scene):
+    mat = grey_material()
+    x0, x1 = FLOOR_X
+    y0, y1 = FLOOR_Y
+    add_quad(scene, "Floor",
+             [(x0, y0, 0.0), (x1, y0, 0.0), (x1, y1, 0.0), (x0, y1, 0.0)], mat)
+    # The wall faces -Y (towards the camera) and shares the floor's back edge.
+    add_quad(scene, "Wall",
+             [(x0, WALL_Y, 0.0), (x1, WALL_Y, 0.0),
+              (x1, WALL_Y, WALL_HEIGHT), (x0, WALL_Y, WALL_HEIGHT)], mat)
+    # A box standing on the floor, its back face touching the wall.
+    add_box(scene, "BoxAtWall", (1.0, 0.9, 1.1), (-1.6, WALL_Y - 0.45, 0.55), mat)
+    # Two stacked boxes: the top one is smaller and set off-centre.
+    add_box(scene, "StackBottom", (1.1, 1.0, 0.7), (0.9, 0.9, 0.35), mat)
+    add_box(scene, "StackTop", (0.6, 0.6, 0.5), (0.75, 0.85, 0.95), mat,
+            rotation_z_deg=12.0)
+    # A box rotated about Z, standing alone on the floor.
+    add_box(scene, "RotatedBox", (0.8, 0.8, 0.8), (-0.5, -0.6, 0.4), mat,
+            rotation_z_deg=-20.0)
+    # A sphere resting on the floor (curved contact).
+    add_sphere(scene, "Sphere", 0.5, (1.2, -0.35, 0.5), mat)
+
+
+def setup_world(scene, ao_distance):
+    world = scene.world
+    if world is None:
+        world = bpy.data.worlds.new("World")
+        scene.world = world
+    world.use_nodes = True
+    nodes = world.node_tree.nodes
+    nodes.clear()
+    bg = nodes.new("ShaderNodeBackground")
+    bg.inputs["Color"].default_value = WORLD_COLOR
+    bg.inputs["Strength"].default_value = 0.6
+    out = nodes.new("ShaderNodeOutputWorld")
+    world.node_tree.links.new(bg.outputs["Background"], out.inputs["Surface"])
+    world.color = WORLD_COLOR[:3]
+    # Cycles' AO pass counts occluders within this distance.
+    world.light_settings.distance = ao_distance
+    return world
+
+
+def add_sun(scene):
+    light = bpy.data.lights.new("Sun", type="SUN")
+    light.energy = 2.0
+    light.angle = math.radians(3.0)
+    obj = bpy.data.objects.new("Sun", light)
+    # Sun from behind the camera, high on its left: shadows fall right and back.
+    obj.rotation_euler = Euler((math.radians(40.0), 0.0, math.radians(-35.0)), "XYZ")
+    scene.collection.objects.link(obj)
+    return obj
+
+
+def add_camera(scene, kind):
+    cam = bpy.data.cameras.new("Camera")
+    cam.lens = CAMERA_LENS
+    cam.sensor_width = CAMERA_SENSOR_WIDTH
+    cam.sensor_fit = "AUTO"
+    cam.shift_x = 0.0
+    cam.shift_y = 0.0
+    cam.clip_start, cam.clip_end = CAMERA_CLIP
+    distance = (CAMERA_TARGET - CAMERA_LOCATION).length
+    if kind == "ortho":
+        cam.type = "ORTHO"
+        # The perspective camera's view at the target distance: with sensor fit
+        # AUTO the sensor width spans the larger image side.
+        fit = cam.sensor_width / cam.lens
+        cam.ortho_scale = distance * fit
+    else:
+        cam.type = "PERSP"
+    obj = bpy.data.objects.new("Camera", cam)
+    direction = CAMERA_TARGET - CAMERA_LOCATION
+    rot = direction.to_track_quat("-Z", "Y").to_matrix().to_4x4()
+    obj.matrix_world = Matrix.Translation(CAMERA_LOCATION) @ rot
+    scene.collection.objects.link(obj)
+    scene.camera = obj
+    return obj
+
+
+# ---------------------------------------------------------------------------
+# Render settings
+
+def configure_cycles(scene, args):
+    scene.render.engine = "CYCLES"
+    cycles = scene.cycles
+    cycles.device = "CPU"
+    cycles.samples = args.samples
+    cycles.use_adaptive_sampling = False
+    # Debian's Blender is built without OpenImageDenoise: denoising must be off.
+    cycles.use_denoising = False
+    cycles.seed = args.seed
+    cycles.use_animated_seed = False
+    # The AO pass does not depend on the bounces; the Combined pass needs few.
+    cycles.max_bounces = 4
+    cycles.diffuse_bounces = 4
+
+
+# Engines that can render the reference. An EEVEE entry would set its own
+# options here (and its depth background is 65504, not 1e10).
+ENGINES = {
+    "cycles": configure_cycles,
+}
+
+
+def configure_render(scene, args, exr_path):
+    r = scene.render
+    r.resolution_x = args.width
+    r.resolution_y = args.height
+    r.resolution_percentage = 100
+    r.pixel_aspect_x = 1.0
+    r.pixel_aspect_y = 1.0
+    r.film_transparent = False
+    r.use_border = False
+    r.threads_mode = "FIXED"
+    r.threads = args.threads
+    # Write the render result itself: no compositing, no sequencer.
+    r.use_compositing = False
+    r.use_sequencer = False
+    # The EXR gets no paths, dates or timings, so that it is reproducible.
+    for flag in ("use_stamp_date", "use_stamp_time", "use_stamp_render_time",
+                 "use_stamp_frame", "use_stamp_frame_range", "use_stamp_memory",
+                 "use_stamp_hostname", "use_stamp_filename", "use_stamp_marker",
+                 "use_stamp_sequencer_strip", "use_stamp_note"):
+        if hasattr(r, flag):
+            setattr(r, flag, False)
+    r.use_stamp_camera = True
+    r.use_stamp_scene = True
+    r.use_stamp_lens = False
+
+    img = r.image_settings
+    img.file_format = "OPEN_EXR_MULTILAYER"
+    img.color_depth = "32"
+    img.exr_codec = "ZIP"
+    if hasattr(img, "use_preview"):
+        img.use_preview = False
+    # The path already ends in .exr; with the extension option on, Blender keeps it.
+    r.use_file_extension = True
+    r.filepath = exr_path
+
+    # Exactly one view layer, named ViewLayer, with the passes we need.
+    while len(scene.view_layers) > 1:
+        scene.view_layers.remove(scene.view_layers[-1])
+    layer = scene.view_layers[0]
+    layer.name = VIEW_LAYER_NAME
+    layer.use = True
+    layer.use_pass_combined = True
+    layer.use_pass_z = True
+    layer.use_pass_normal = True
+    layer.use_pass_ambient_occlusion = not args.no_ao_pass
+    return layer
+
+
+# ---------------------------------------------------------------------------
+# Output
+
+def matrix_rows(m):
+    return [[float(m[r][c]) for c in range(len(m[r]))] for r in range(len(m))]
+
+
+def camera_description(cam_obj):
+    """The camera JSON of docs/conventions.md (fields named after bpy.types.Camera)."""
+    cam = cam_obj.data
+    return {
+        "type": cam.type,
+        "lens": float(cam.lens),
+        "sensor_width": float(cam.sensor_width),
+        "sensor_height": float(cam.sensor_height),
+        "sensor_fit": cam.sensor_fit,
+        "shift_x": float(cam.shift_x),
+        "shift_y": float(cam.shift_y),
+        "ortho_scale": float(cam.ortho_scale),
+        "clip_start": float(cam.clip_start),
+        "clip_end": float(cam.clip_end),
+        "matrix_world": matrix_rows(cam_obj.matrix_world),
+    }
+
+
+def write_json(path, data):
+    tmp = path + ".tmp"
+    with open(tmp, "w", encoding="utf-8") as f:
+        json.dump(data, f, indent=1)
+        f.write("\n")
+    os.replace(tmp, path)
+
+
+def main():
+    args = parse_args(script_argv())
+    prefix = os.path.abspath(args.out)
+    out_dir = os.path.dirname(prefix)
+    os.makedirs(out_dir, exist_ok=True)
+    exr_path = prefix + ".exr"
+    camera_path = prefix + ".camera.json"
+    meta_path = prefix + ".json"
+    scene_name = args.scene_name or os.path.basename(prefix)
+
+    for path in (exr_path, camera_path, meta_path):
+        if os.path.exists(path):
+            os.remove(path)
+
+    scene = bpy.context.scene
+    clear_scene(scene)
+    build_geometry(scene)
+    setup_world(scene, args.ao_distance)
+    add_sun(scene)
+    cam_obj = add_camera(scene, args.camera)
+    scene.frame_set(1)
+
+    ENGINES[args.engine](scene, args)
+    layer = configure_render(scene, args, exr_path)
+    if bpy.context.view_layer is not None:
+        bpy.context.view_layer.update()
+
+    t0 = time.perf_counter()
+    result = bpy.ops.render.render(write_still=True, scene=scene.name)
+    render_seconds = time.perf_counter() - t0
+    if "FINISHED" not in result:
+        raise RuntimeError("render.render returned %s" % (result,))
+    if not os.path.isfile(exr_path):
+        listing = sorted(os.listdir(out_dir))
+        raise RuntimeError("expected %s after rendering; the folder holds %s"
+                           % (exr_path, listing))
+
+    depsgraph = bpy.context.evaluated_depsgraph_get()
+    projection = cam_obj.calc_matrix_camera(
+        depsgraph, x=args.width, y=args.height, scale_x=1.0, scale_y=1.0)
+
+    camera = camera_description(cam_obj)
+    write_json(camera_path, camera)
+    passes = ["Combined", "Depth", "Normal"] + ([] if args.no_ao_pass else ["AO"])
+    meta = {
+        "scene": scene_name,
+        "width": args.width,
+        "height": args.height,
+        "samples": args.samples,
+        "ao_distance": args.ao_distance,
+        "render_seconds": round(render_seconds, 3),
+        "engine": args.engine.upper(),
+        "camera_type": camera["type"],
+        "seed": args.seed,
+        "threads": args.threads,
+        "view_layer": layer.name,
+        "passes": passes,
+        "blender_version": bpy.app.version_string,
+        "projection": matrix_rows(projection),
+    }
+    write_json(meta_path, meta)
+
+    print("make_reference_scene: wrote %s (%dx%d, %d spp, %s %s, passes %s, "
+          "ao_distance %g) in %.2f s render time, %d bytes"
+          % (exr_path, args.width, args.height, args.samples, args.engine,
+             camera["type"], "+".join(passes), args.ao_distance, render_seconds,
+             os.path.getsize(exr_path)))
+
+
+if __name__ == "__main__":
+    try:
+        main()
+    except SystemExit:
+        raise
+    except BaseException:
+        traceback.print_exc()
+        print("make_reference_scene: FAILED", file=sys.stderr)
+        sys.stdout.flush()
+        sys.stderr.flush()
+        sys.exit(1)

@@ -1,0 +1,486 @@
+#!/usr/bin/python3
+# SPDX-License-Identifier: MIT
+"""End-to-end tests of the ssao command-line tool (build/bin/ssao).
+
+Run with the system Python (numpy + OpenImageIO bindings):
+    /usr/bin/python3 tests/cli/test_cli.py --ssao build/bin/ssao --lib build/lib/libssao.so \
+        --scratch /tmp/ssao-cli-tests [unittest arguments, e.g. a TestCase name]
+The same paths may come from the environment: SSAO_CLI, SSAO_LIB, SSAO_SCRATCH. Set
+SSAO_KEEP_SCRATCH=1 to keep each test's folder (inputs, outputs) for inspection.
+
+Every test builds its own inputs: a 64x48 Blender-like multilayer EXR (ViewLayer.Combined.R/G/B/A,
+ViewLayer.Depth.Z, ViewLayer.Normal.X/Y/Z) showing a wall 10 units from the camera with a box
+whose front face is 2 units closer, and the sky (depth 1e10, normal 0) along the top rows.
+"""
+
+import argparse
+import ctypes
+import json
+import math
+import os
+import shutil
+import subprocess
+import sys
+import tempfile
+import unittest
+
+import numpy as np
+import OpenImageIO as oiio
+
+SSAO = os.environ.get("SSAO_CLI", "")
+LIB = os.environ.get("SSAO_LIB", "")
+SCRATCH = os.environ.get("SSAO_SCRATCH", "")
+
+WIDTH, HEIGHT = 64, 48
+SKY_ROWS = 12                   # rows 0..11 show the sky (background)
+BOX_X, BOX_Y = (24, 40), (24, 40)  # the box's front face, pixel ranges [start, end)
+WALL_DEPTH, BOX_DEPTH, SKY_DEPTH = 10.0, 8.0, 1e10
+RADIUS = 3.0
+
+# Camera: rotated 30 degrees about the world Z axis and moved; normals are written in world
+# space (Blender's convention), so the tool must use matrix_world to read them.
+_ANGLE = math.radians(30.0)
+CAMERA_TO_WORLD = np.array([
+    [math.cos(_ANGLE), -math.sin(_ANGLE), 0.0, 1.0],
+    [math.sin(_ANGLE), math.cos(_ANGLE), 0.0, 2.0],
+    [0.0, 0.0, 1.0, 3.0],
+    [0.0, 0.0, 0.0, 1.0],
+])
+
+CAMERA = {
+    "type": "PERSP", "lens": 35.0, "sensor_width": 36.0, "sensor_height": 24.0,
+    "sensor_fit": "AUTO", "shift_x": 0.0, "shift_y": 0.0, "ortho_scale": 6.0,
+    "clip_start": 0.1, "clip_end": 1000.0, "matrix_world": CAMERA_TO_WORLD.tolist(),
+}
+
+BLENDER_CHANNELS = ["ViewLayer.Combined.R", "ViewLayer.Combined.G", "ViewLayer.Combined.B",
+                    "ViewLayer.Combined.A", "ViewLayer.Depth.Z", "ViewLayer.Normal.X",
+                    "ViewLayer.Normal.Y", "ViewLayer.Normal.Z"]
+
+# Parameters the usage contract names; --help must list them whatever the table holds.
+CONTRACT_PARAMS = ["variant", "radius", "samples", "sphere_mode", "denoise", "depth_kind",
+                   "normal_space", "bias", "strength", "power", "remap_min", "remap_max", "seed",
+                   "threads"]
+
+
+def make_scene():
+    """Returns dict of planes (HEIGHT x WIDTH float32 arrays), keyed by Blender channel name."""
+    depth = np.full((HEIGHT, WIDTH), WALL_DEPTH, np.float32)
+    depth[:SKY_ROWS, :] = SKY_DEPTH
+    depth[BOX_Y[0]:BOX_Y[1], BOX_X[0]:BOX_X[1]] = BOX_DEPTH
+    sky = depth == SKY_DEPTH
+
+    # Both visible faces face the camera: +Z in camera space, rotated to world space.
+    normal_world = CAMERA_TO_WORLD[:3, :3] @ np.array([0.0, 0.0, 1.0])
+    planes = {"ViewLayer.Depth.Z": depth}
+    for axis, name in enumerate("XYZ"):
+        n = np.full((HEIGHT, WIDTH), normal_world[axis], np.float32)
+        n[sky] = 0.0
+        planes["ViewLayer.Normal." + name] = n
+
+    ys, xs = np.mgrid[0:HEIGHT, 0:WIDTH].astype(np.float32)
+    planes["ViewLayer.Combined.R"] = (xs + 0.5) / WIDTH
+    planes["ViewLayer.Combined.G"] = (ys + 0.5) / HEIGHT
+    planes["ViewLayer.Combined.B"] = np.full((HEIGHT, WIDTH), 0.25, np.float32)
+    planes["ViewLayer.Combined.A"] = np.where(sky, 0.0, 1.0).astype(np.float32)
+    return planes
+
+
+def write_exr(path, planes, names=None):
+    names = list(planes.keys()) if names is None else names
+    pixels = np.stack([planes[n] for n in names], axis=-1).astype(np.float32)
+    spec = oiio.ImageSpec(WIDTH, HEIGHT, len(names), oiio.FLOAT)
+    spec.channelnames = tuple(names)
+    spec.alpha_channel = -1
+    spec.attribute("compression", "zip")
+    out = oiio.ImageOutput.create(path)
+    assert out is not None, oiio.geterror()
+    assert out.open(path, spec), out.geterror()
+    assert out.write_image(pixels), out.geterror()
+    out.close()
+
+
+def read_exr(path):
+    """Returns (channel names, float32 array HEIGHT x WIDTH x channels). ImageInput, not
+    ImageBuf: ImageBuf's cache would return stale pixels for a file rewritten under one name."""
+    inp = oiio.ImageInput.open(path)
+    assert inp is not None, oiio.geterror()
+    spec = inp.spec()
+    pixels = inp.read_image(oiio.FLOAT)
+    assert pixels is not None, inp.geterror()
+    inp.close()
+    return list(spec.channelnames), pixels.reshape(spec.height, spec.width, spec.nchannels)
+
+
+def core_param_names():
+    """The parameter names of the core's table, read through the C API with ctypes."""
+    class ParamDesc(ctypes.Structure):
+        _fields_ = [("name", ctypes.c_char_p), ("type", ctypes.c_int),
+                    ("default_value", ctypes.c_double), ("min_value", ctypes.c_double),
+                    ("max_value", ctypes.c_double), ("default_string", ctypes.c_char_p),
+                    ("choices", ctypes.c_char_p), ("count", ctypes.c_size_t),
+                    ("unit", ctypes.c_char_p), ("description", ctypes.c_char_p)]
+    lib = ctypes.CDLL(LIB)
+    lib.ssao_param_count.restype = ctypes.c_size_t
+    lib.ssao_param_info.argtypes = [ctypes.c_size_t, ctypes.POINTER(ParamDesc)]
+    names = []
+    for i in range(lib.ssao_param_count()):
+        desc = ParamDesc()
+        assert lib.ssao_param_info(i, ctypes.byref(desc)) == 0
+        names.append(desc.name.decode())
+    return names, lib.ssao_version()
+
+
+class CliTestCase(unittest.TestCase):
+    """A fresh folder per test with the standard input and camera."""
+
+    def setUp(self):
+        os.makedirs(SCRATCH, exist_ok=True)
+        self.dir = tempfile.mkdtemp(prefix=self.id().split(".")[-1] + "-", dir=SCRATCH)
+        self.planes = make_scene()
+        self.input = self.path("in.exr")
+        write_exr(self.input, self.planes, BLENDER_CHANNELS)
+        self.camera = self.write_camera(CAMERA)
+        self.output = self.path("out.exr")
+
+    def tearDown(self):
+        if not os.environ.get("SSAO_KEEP_SCRATCH"):
+            shutil.rmtree(self.dir, ignore_errors=True)
+
+    def path(self, name):
+        return os.path.join(self.dir, name)
+
+    def write_camera(self, content, name="camera.json"):
+        path = self.path(name)
+        with open(path, "w") as f:
+            f.write(content if isinstance(content, str) else json.dumps(content))
+        return path
+
+    def run_ssao(self, *args, default_paths=True):
+        cmd = [SSAO]
+        if default_paths:
+            cmd += [self.input, "-o", self.output, "--camera", self.camera, "--radius", str(RADIUS)]
+        cmd += [str(a) for a in args]
+        proc = subprocess.run(cmd, capture_output=True, text=True, timeout=120)
+        self.last_command = " ".join(cmd)
+        return proc
+
+    def assert_ok(self, proc):
+        self.assertEqual(proc.returncode, 0,
+                         f"{self.last_command}\nstdout: {proc.stdout}\nstderr: {proc.stderr}")
+        self.assertTrue(os.path.isfile(self.output))
+
+    def assert_fails(self, proc, code, *phrases, output=None):
+        """Exit status `code`, "ssao: error:" with every phrase on stderr, and no output file."""
+        output = self.output if output is None else output
+        detail = f"{self.last_command}\nstderr: {proc.stderr}"
+        self.assertEqual(proc.returncode, code, detail)
+        self.assertIn("ssao: error:", proc.stderr, detail)
+        for phrase in phrases:
+            self.assertIn(phrase, proc.stderr, detail)
+        self.assertFalse(os.path.exists(output), f"{output} exists after a failure\n{detail}")
+        folder = os.path.dirname(output)
+        leftovers = [f for f in os.listdir(folder) if ".tmp" in f] if os.path.isdir(folder) else []
+        self.assertEqual(leftovers, [], "temporary files left behind")
+
+
+class GoodRunTest(CliTestCase):
+
+    def test_composite_is_beauty_times_ao(self):
+        proc = self.run_ssao()
+        self.assert_ok(proc)
+        names, out = read_exr(self.output)
+        self.assertEqual(sorted(names), ["A", "AO", "B", "G", "R"])
+        ao = out[:, :, names.index("AO")]
+        self.assertTrue(np.all(np.isfinite(ao)))
+        self.assertGreaterEqual(float(ao.min()), 0.0)
+        self.assertLessEqual(float(ao.max()), 1.0)
+        for channel in "RGB":
+            beauty = self.planes["ViewLayer.Combined." + channel]
+            np.testing.assert_allclose(out[:, :, names.index(channel)], beauty * ao, rtol=0,
+                                       atol=1e-6, err_msg=channel)
+        np.testing.assert_array_equal(out[:, :, names.index("A")],
+                                      self.planes["ViewLayer.Combined.A"])
+
+        # Sky: unoccluded.
+        np.testing.assert_allclose(ao[:SKY_ROWS, :], 1.0, rtol=0, atol=1e-6)
+        # The wall right around the box is occluded by it; the middle of the box's flat front
+        # face is not.
+        ring = np.zeros((HEIGHT, WIDTH), bool)
+        ring[BOX_Y[0] - 3:BOX_Y[1] + 3, BOX_X[0] - 3:BOX_X[1] + 3] = True
+        ring[BOX_Y[0]:BOX_Y[1], BOX_X[0]:BOX_X[1]] = False
+        box_centre = ao[BOX_Y[0] + 6:BOX_Y[1] - 6, BOX_X[0] + 6:BOX_X[1] - 6]
+        self.assertLess(float(ao[ring].mean()), 0.95)
+        self.assertGreater(float(box_centre.mean()), 0.9)
+        self.assertLess(float(ao[ring].mean()), float(box_centre.mean()) - 0.05)
+
+        # Progress (stderr is a pipe: lines at quarters) and the summary.
+        self.assertIn("ssao: 100%", proc.stderr)
+        self.assertIn("64x48", proc.stderr)
+        self.assertIn("mean AO", proc.stderr)
+
+    def test_ao_only_writes_one_channel(self):
+        self.assert_ok(self.run_ssao("--ao-only"))
+        names, out = read_exr(self.output)
+        self.assertEqual(names, ["AO"])
+        self.assertEqual(out.shape, (HEIGHT, WIDTH, 1))
+        np.testing.assert_allclose(out[:SKY_ROWS, :, 0], 1.0, rtol=0, atol=1e-6)
+
+    def test_ao_only_matches_composite_run(self):
+        self.assert_ok(self.run_ssao())
+        names, full = read_exr(self.output)
+        os.remove(self.output)
+        self.assert_ok(self.run_ssao("--ao-only"))
+        _, ao_only = read_exr(self.output)
+        np.testing.assert_array_equal(ao_only[:, :, 0], full[:, :, names.index("AO")])
+
+    def test_without_alpha_writes_rgb_and_ao(self):
+        write_exr(self.input, self.planes, [n for n in BLENDER_CHANNELS if n != "ViewLayer.Combined.A"])
+        self.assert_ok(self.run_ssao())
+        names, _ = read_exr(self.output)
+        self.assertEqual(sorted(names), ["AO", "B", "G", "R"])
+
+    def test_result_does_not_depend_on_thread_count(self):
+        self.assert_ok(self.run_ssao("--ao-only", "--threads", "1"))
+        _, one = read_exr(self.output)
+        os.remove(self.output)
+        self.assert_ok(self.run_ssao("--ao-only", "--threads", "3"))
+        _, three = read_exr(self.output)
+        np.testing.assert_array_equal(one, three)
+
+    def test_strength_zero_gives_no_occlusion(self):
+        self.assert_ok(self.run_ssao("--ao-only", "--strength", "0"))
+        _, off = read_exr(self.output)
+        np.testing.assert_allclose(off, 1.0, rtol=0, atol=1e-6)
+
+    def test_no_normals_reconstructs_from_depth(self):
+        proc = self.run_ssao("--ao-only", "--no-normals")
+        self.assert_ok(proc)
+        self.assertIn("normals from depth", proc.stderr)
+        _, out = read_exr(self.output)
+        self.assertTrue(np.all(np.isfinite(out)))
+        np.testing.assert_allclose(out[:SKY_ROWS, :, 0], 1.0, rtol=0, atol=1e-6)
+
+    def test_quiet_prints_nothing(self):
+        proc = self.run_ssao("--quiet")
+        self.assert_ok(proc)
+        self.assertEqual(proc.stderr, "")
+        self.assertEqual(proc.stdout, "")
+
+    def test_overwrites_an_existing_output(self):
+        with open(self.output, "w") as f:
+            f.write("old")
+        self.assert_ok(self.run_ssao("--ao-only"))
+        self.assertEqual(read_exr(self.output)[0], ["AO"])
+
+    def test_explicit_channels_and_single_layer_file(self):
+        names = {"ViewLayer.Depth.Z": "Z", "ViewLayer.Combined.R": "R",
+                 "ViewLayer.Combined.G": "G", "ViewLayer.Combined.B": "B",
+                 "ViewLayer.Normal.X": "N.X", "ViewLayer.Normal.Y": "N.Y",
+                 "ViewLayer.Normal.Z": "N.Z"}
+        write_exr(self.input, {names[k]: v for k, v in self.planes.items() if k in names})
+        self.assert_ok(self.run_ssao())
+        got, _ = read_exr(self.output)
+        self.assertEqual(sorted(got), ["AO", "B", "G", "R"])
+        os.remove(self.output)
+        self.assert_ok(self.run_ssao("--depth-channel", "Z", "--normal-channels", "N.X,N.Y,N.Z",
+                                     "--beauty-channels", "B,G,R"))
+
+    def test_layer_choice(self):
+        planes = dict(self.planes)
+        for name in BLENDER_CHANNELS:
+            planes["Other" + name[len("ViewLayer"):]] = self.planes[name]
+        write_exr(self.input, planes)
+        self.assert_fails(self.run_ssao(), 1, "--layer", "ViewLayer", "Other")
+        self.assert_ok(self.run_ssao("--layer", "Other"))
+
+
+class BackgroundDepthTest(CliTestCase):
+
+    def test_nan_inf_and_negative_depth_are_background(self):
+        depth = self.planes["ViewLayer.Depth.Z"]
+        bad = {(40, 5): np.nan, (41, 5): np.inf, (42, 5): -np.inf, (43, 5): -1.0, (44, 5): 0.0,
+               (30, 30): np.nan, (20, 50): -3.0}
+        for (y, x), value in bad.items():
+            depth[y, x] = value
+        write_exr(self.input, self.planes, BLENDER_CHANNELS)
+        proc = self.run_ssao()
+        self.assert_ok(proc)
+        names, out = read_exr(self.output)
+        ao = out[:, :, names.index("AO")]
+        self.assertTrue(np.all(np.isfinite(ao)), "AO has non-finite values")
+        for (y, x) in bad:
+            self.assertAlmostEqual(float(ao[y, x]), 1.0, places=6, msg=f"pixel ({x}, {y})")
+        self.assertTrue(np.all(np.isfinite(out[:, :, names.index("R")])))
+
+    def test_beyond_clip_end_is_background(self):
+        camera = dict(CAMERA, clip_end=9.0)  # the wall (10) is now beyond clip_end
+        self.camera = self.write_camera(camera)
+        self.assert_ok(self.run_ssao("--ao-only"))
+        _, out = read_exr(self.output)
+        wall = self.planes["ViewLayer.Depth.Z"] == WALL_DEPTH
+        np.testing.assert_allclose(out[:, :, 0][wall], 1.0, rtol=0, atol=1e-6)
+
+
+class HelpTest(CliTestCase):
+
+    def test_help_lists_every_parameter(self):
+        proc = self.run_ssao("--help", default_paths=False)
+        self.assertEqual(proc.returncode, 0, proc.stderr)
+        table, _ = core_param_names()
+        self.assertGreater(len(table), 10)
+        for name in set(table) | set(CONTRACT_PARAMS):
+            self.assertIn("--" + name.replace("_", "-") + " ", proc.stdout, name)
+        for flag in ["-o", "--camera", "--ao-only", "--layer", "--depth-channel",
+                     "--normal-channels", "--beauty-channels", "--no-normals", "--quiet",
+                     "--version", "hemisphere|sphere", "default 16"]:
+            self.assertIn(flag, proc.stdout)
+
+    def test_version(self):
+        proc = self.run_ssao("--version", default_paths=False)
+        self.assertEqual(proc.returncode, 0)
+        _, version = core_param_names()
+        expected = f"{version // 10000}.{version // 100 % 100}.{version % 100}"
+        self.assertEqual(proc.stdout.strip(), "ssao " + expected)
+
+    def test_every_parameter_is_accepted(self):
+        # A value from the help's own defaults would be ideal; these are valid for the contract.
+        values = {"variant": "sphere", "radius": "2.5", "samples": "8", "sphere_mode": "classic",
+                  "denoise": "box4", "depth_kind": "planar", "normal_space": "world",
+                  "bias": "0.05", "strength": "0.8", "power": "1.5", "remap_min": "0.1",
+                  "remap_max": "0.9", "seed": "7", "threads": "2"}
+        args = []
+        for name, value in values.items():
+            args += ["--" + name.replace("_", "-"), value]
+        self.assert_ok(self.run_ssao("--ao-only", *args))
+        _, out = read_exr(self.output)
+        geometry = out[SKY_ROWS:, :, 0]  # the sky stays at 1 whatever the remapping
+        self.assertTrue(np.all((geometry >= 0.1 - 1e-6) & (geometry <= 0.9 + 1e-6)))
+
+
+class BadInputTest(CliTestCase):
+
+    def test_missing_input_file(self):
+        self.input = self.path("nothing-here.exr")
+        self.assert_fails(self.run_ssao(), 1, "nothing-here.exr", "no such file")
+
+    def test_truncated_exr(self):
+        with open(self.input, "rb") as f:
+            data = f.read()
+        with open(self.input, "wb") as f:
+            f.write(data[:len(data) // 2])
+        self.assert_fails(self.run_ssao(), 1, "in.exr", "truncated or corrupt")
+
+    def test_not_an_image(self):
+        with open(self.input, "w") as f:
+            f.write("this is not an EXR file\n" * 20)
+        self.assert_fails(self.run_ssao(), 1, "in.exr", "not an image")
+
+    def test_missing_depth_channel_lists_channels(self):
+        write_exr(self.input, self.planes, [n for n in BLENDER_CHANNELS if "Depth" not in n])
+        proc = self.run_ssao()
+        self.assert_fails(proc, 1, "no depth channel", "ViewLayer.Combined.R",
+                          "ViewLayer.Normal.Z")
+
+    def test_named_channel_missing_lists_channels(self):
+        self.assert_fails(self.run_ssao("--depth-channel", "Depth"), 1, "'Depth'",
+                          "ViewLayer.Depth.Z")
+        self.assert_fails(self.run_ssao("--normal-channels", "a,b,c"), 1, "'a'",
+                          "ViewLayer.Normal.X")
+
+    def test_no_beauty_without_ao_only(self):
+        write_exr(self.input, self.planes, [n for n in BLENDER_CHANNELS if "Combined" not in n])
+        self.assert_fails(self.run_ssao(), 1, "--ao-only", "--beauty-channels")
+        self.assert_ok(self.run_ssao("--ao-only"))
+
+    def test_malformed_camera_json(self):
+        self.camera = self.write_camera('{"type": "PERSP", "lens": 35.0,')
+        self.assert_fails(self.run_ssao(), 1, "camera.json", "malformed JSON")
+
+    def test_camera_lens_is_a_string(self):
+        self.camera = self.write_camera(dict(CAMERA, lens="35mm"))
+        self.assert_fails(self.run_ssao(), 1, "camera.json", "'lens'", "must be a number")
+
+    def test_camera_problems(self):
+        cases = [
+            ({k: v for k, v in CAMERA.items() if k != "type"}, "missing key 'type'"),
+            (dict(CAMERA, type="PANO"), "'type'"),
+            (dict(CAMERA, matrix_world=[[1, 0, 0], [0, 1, 0], [0, 0, 1]]), "4x4"),
+            (dict(CAMERA, sensor_fit=3), "'sensor_fit'"),
+            (dict(CAMERA, lens=-5.0), "lens"),  # rejected by the core's range check
+            ("[1, 2, 3]", "JSON object"),
+            ('{"type": "PERSP", "lens": 1e999}', "1e999"),
+        ]
+        for content, phrase in cases:
+            with self.subTest(phrase=phrase):
+                self.camera = self.write_camera(content)
+                self.assert_fails(self.run_ssao(), 1, phrase)
+        self.camera = self.path("no-camera.json")
+        self.assert_fails(self.run_ssao(), 1, "no-camera.json", "no such file")
+
+    def test_missing_camera_flag(self):
+        proc = self.run_ssao(self.input, "-o", self.output, default_paths=False)
+        self.assert_fails(proc, 2, "--camera")
+
+    def test_missing_output_flag(self):
+        proc = self.run_ssao(self.input, "--camera", self.camera, default_paths=False)
+        self.assertEqual(proc.returncode, 2)
+        self.assertIn("-o", proc.stderr)
+        self.assertEqual(sorted(os.listdir(self.dir)), ["camera.json", "in.exr"])
+
+    def test_unknown_flag(self):
+        self.assert_fails(self.run_ssao("--frobnicate", "3"), 2, "unknown option '--frobnicate'")
+        self.assert_fails(self.run_ssao("--radiuss", "3"), 2, "did you mean --radius")
+
+    def test_bad_values(self):
+        cases = [
+            (["--samples", "abc"], "--samples", "integer"),
+            (["--samples", "1.5"], "--samples", "integer"),
+            (["--radius", "nan"], "--radius", "finite"),
+            (["--radius", "inf"], "--radius", "finite"),
+            (["--radius", "-1"], "--radius", "radius"),   # the core's range check
+            (["--samples", "0"], "--samples", "samples"),  # the core's range check
+            (["--variant", "foo"], "--variant", "hemisphere"),
+            (["--radius"], "--radius", "requires a value"),
+            (["--normal-channels", "X,Y"], "--normal-channels", "3"),
+            (["--no-normals", "--normal-channels", "a,b,c"], "--no-normals", "--normal-channels"),
+        ]
+        for args, *phrases in cases:
+            with self.subTest(args=args):
+                self.assert_fails(self.run_ssao(*args), 2, *phrases)
+
+    def test_output_is_input(self):
+        with open(self.input, "rb") as f:
+            before = f.read()
+        proc = self.run_ssao(self.input, "-o", self.input, "--camera", self.camera,
+                             default_paths=False)
+        self.assertEqual(proc.returncode, 2, proc.stderr)
+        self.assertIn("is the input file", proc.stderr)
+        with open(self.input, "rb") as f:
+            self.assertEqual(f.read(), before)
+        # The same file through another spelling of its path.
+        other = os.path.join(self.dir, ".", "in.exr")
+        proc = self.run_ssao(self.input, "-o", other, "--camera", self.camera, default_paths=False)
+        self.assertEqual(proc.returncode, 2, proc.stderr)
+
+    def test_unwritable_output_leaves_nothing(self):
+        self.output = self.path("missing-folder/out.exr")
+        self.assert_fails(self.run_ssao(), 1, "cannot write", "missing-folder")
+
+
+def main():
+    global SSAO, LIB, SCRATCH
+    parser = argparse.ArgumentParser(add_help=False)
+    parser.add_argument("--ssao", default=SSAO)
+    parser.add_argument("--lib", default=LIB)
+    parser.add_argument("--scratch", default=SCRATCH)
+    args, rest = parser.parse_known_args()
+    SSAO, LIB = os.path.abspath(args.ssao), os.path.abspath(args.lib)
+    SCRATCH = os.path.abspath(args.scratch or tempfile.mkdtemp(prefix="ssao-cli-tests-"))
+    if not os.access(SSAO, os.X_OK) or not os.path.isfile(LIB):
+        sys.exit(f"test_cli.py: need --ssao BINARY and --lib LIBSSAO (got '{SSAO}', '{LIB}')")
+    unittest.main(argv=[sys.argv[0]] + rest, verbosity=2)
+
+
+if __name__ == "__main__":
+    main()

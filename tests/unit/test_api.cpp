@@ -1,0 +1,368 @@
+// SPDX-License-Identifier: MIT
+// The C API contract: statuses and messages for bad handles, names, values and images; hostile
+// pixel values; edge sizes; strides; progress and cancellation; thread-count invariance.
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <limits>
+#include <string>
+#include <thread>
+
+#include "analytic_scene.h"
+
+using namespace test;
+
+namespace {
+
+// A floor with a wall behind it, seen from above at an angle: enough occlusion to compare runs.
+Scene floor_and_wall(const Camera& cam) {
+  return ray_cast(cam,
+                  {{{0, -1, -6}, normalized({0, 1, 0.0})}, {{0, 0, -8}, normalized({0, 0.2, 1})}},
+                  Combine::union_concave);
+}
+
+bool contains(const char* haystack, const char* needle) {
+  return std::strstr(haystack, needle) != nullptr;
+}
+
+}  // namespace
+
+TEST(Api, VersionAndStatusStrings) {
+  EXPECT_EQ(ssao_version(), SSAO_VERSION);
+  EXPECT_STREQ(ssao_status_string(SSAO_ERROR_CANCELLED), "cancelled");
+}
+
+TEST(Api, NullHandlesAndPointersAreRejected) {
+  EXPECT_EQ(ssao_job_create(nullptr), SSAO_ERROR_INVALID_ARGUMENT);
+  EXPECT_EQ(ssao_job_set_float(nullptr, "radius", 1.0), SSAO_ERROR_INVALID_ARGUMENT);
+  EXPECT_TRUE(contains(ssao_last_error(), "NULL"));
+  EXPECT_EQ(ssao_job_run(nullptr), SSAO_ERROR_INVALID_ARGUMENT);
+  ssao_job_destroy(nullptr);  // a no-op
+  Job job;
+  EXPECT_EQ(ssao_job_set_float(job.get(), nullptr, 1.0), SSAO_ERROR_INVALID_ARGUMENT);
+  EXPECT_EQ(ssao_job_set_string(job.get(), "variant", nullptr), SSAO_ERROR_INVALID_ARGUMENT);
+  EXPECT_EQ(ssao_job_get_float(job.get(), "radius", nullptr), SSAO_ERROR_INVALID_ARGUMENT);
+  EXPECT_EQ(ssao_param_info(0, nullptr), SSAO_ERROR_INVALID_ARGUMENT);
+}
+
+TEST(Api, ParameterErrorsNameTheParameter) {
+  Job job;
+  EXPECT_EQ(ssao_job_set_float(job.get(), "radus", 1.0), SSAO_ERROR_INVALID_ARGUMENT);
+  EXPECT_TRUE(contains(ssao_last_error(), "unknown parameter 'radus'"));
+  EXPECT_EQ(ssao_job_set_int(job.get(), "radius", 1), SSAO_ERROR_INVALID_ARGUMENT);
+  EXPECT_TRUE(contains(ssao_last_error(), "is a float"));
+  EXPECT_EQ(ssao_job_set_float(job.get(), "radius", -1.0), SSAO_ERROR_INVALID_ARGUMENT);
+  EXPECT_TRUE(contains(ssao_last_error(), "radius"));
+  EXPECT_EQ(ssao_job_set_float(job.get(), "radius", std::nan("")), SSAO_ERROR_INVALID_ARGUMENT);
+  EXPECT_EQ(ssao_job_set_float(job.get(), "radius", HUGE_VAL), SSAO_ERROR_INVALID_ARGUMENT);
+  EXPECT_EQ(ssao_job_set_int(job.get(), "samples", 0), SSAO_ERROR_INVALID_ARGUMENT);
+  EXPECT_EQ(ssao_job_set_string(job.get(), "variant", "gtao"), SSAO_ERROR_INVALID_ARGUMENT);
+  EXPECT_TRUE(contains(ssao_last_error(), "hemisphere|sphere"));
+  const double short_matrix[3] = {1, 2, 3};
+  EXPECT_EQ(ssao_job_set_floats(job.get(), "camera_to_world", short_matrix, 3),
+            SSAO_ERROR_INVALID_ARGUMENT);
+  double nan_matrix[16] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
+  nan_matrix[5] = std::nan("");
+  EXPECT_EQ(ssao_job_set_floats(job.get(), "camera_to_world", nan_matrix, 16),
+            SSAO_ERROR_INVALID_ARGUMENT);
+  // A failed set leaves the previous value.
+  double radius = 0;
+  EXPECT_EQ(ssao_job_get_float(job.get(), "radius", &radius), SSAO_OK);
+  EXPECT_EQ(radius, 1.0);
+}
+
+TEST(Api, ParameterTableDefaultsRoundTrip) {
+  Job job;
+  const size_t n = ssao_param_count();
+  ASSERT_GT(n, 20u);
+  for (size_t i = 0; i < n; ++i) {
+    ssao_param_desc d;
+    ASSERT_EQ(ssao_param_info(i, &d), SSAO_OK);
+    ASSERT_NE(d.name, nullptr);
+    ASSERT_NE(d.description, nullptr);
+    switch (d.type) {
+      case SSAO_PARAM_INT: {
+        int v = -1;
+        EXPECT_EQ(ssao_job_get_int(job.get(), d.name, &v), SSAO_OK);
+        EXPECT_EQ(v, int(d.default_value)) << d.name;
+        EXPECT_EQ(ssao_job_set_int(job.get(), d.name, v), SSAO_OK) << d.name;
+        EXPECT_GE(d.default_value, d.min_value);
+        EXPECT_LE(d.default_value, d.max_value);
+        break;
+      }
+      case SSAO_PARAM_FLOAT: {
+        double v = -1;
+        EXPECT_EQ(ssao_job_get_float(job.get(), d.name, &v), SSAO_OK);
+        EXPECT_EQ(v, d.default_value) << d.name;
+        EXPECT_EQ(ssao_job_set_float(job.get(), d.name, v), SSAO_OK) << d.name;
+        break;
+      }
+      case SSAO_PARAM_STRING: {
+        char buf[64];
+        EXPECT_EQ(ssao_job_get_string(job.get(), d.name, buf, sizeof buf), SSAO_OK);
+        EXPECT_STREQ(buf, d.default_string);
+        EXPECT_TRUE(contains(d.choices, d.default_string)) << d.name;
+        break;
+      }
+      case SSAO_PARAM_FLOATS: {
+        std::vector<double> v(d.count);
+        EXPECT_EQ(ssao_job_get_floats(job.get(), d.name, v.data(), v.size()), SSAO_OK);
+        EXPECT_EQ(ssao_job_set_floats(job.get(), d.name, v.data(), v.size()), SSAO_OK);
+        break;
+      }
+    }
+  }
+  ssao_param_desc d;
+  EXPECT_EQ(ssao_param_info(n, &d), SSAO_ERROR_INVALID_ARGUMENT);
+  char tiny[4];
+  EXPECT_EQ(ssao_job_get_string(job.get(), "variant", tiny, sizeof tiny), SSAO_OK);
+  EXPECT_STREQ(tiny, "hem");  // truncated, still terminated
+}
+
+TEST(Api, ImageErrors) {
+  Job job;
+  std::vector<float> depth(16, 5.0f), ao(16), small(4), rgb(48);
+  EXPECT_EQ(ssao_job_set_image(job.get(), "dpeth", depth.data(), 4, 4, 1, 0, 0),
+            SSAO_ERROR_INVALID_ARGUMENT);
+  EXPECT_TRUE(contains(ssao_last_error(), "unknown image 'dpeth'"));
+  EXPECT_EQ(ssao_job_set_image(job.get(), "normal", rgb.data(), 4, 4, 1, 0, 0),
+            SSAO_ERROR_INVALID_ARGUMENT);
+  EXPECT_EQ(ssao_job_set_image(job.get(), "depth", depth.data(), -4, 4, 1, 0, 0),
+            SSAO_ERROR_INVALID_ARGUMENT);
+  EXPECT_EQ(ssao_job_set_image(job.get(), "depth", depth.data(), 4, 4, 1, 2, 0),
+            SSAO_ERROR_INVALID_ARGUMENT);  // pixel stride smaller than a float
+  EXPECT_EQ(ssao_job_set_image(job.get(), "depth", depth.data(), 4, 4, 1, 4, 8),
+            SSAO_ERROR_INVALID_ARGUMENT);  // row stride smaller than a row
+
+  // Nothing attached, then no output, then mismatched sizes, then composite without beauty.
+  EXPECT_EQ(ssao_job_run(job.get()), SSAO_ERROR_INVALID_OPERATION);
+  EXPECT_TRUE(contains(ssao_last_error(), "no depth image"));
+  ASSERT_EQ(ssao_job_set_image(job.get(), "depth", depth.data(), 4, 4, 1, 0, 0), SSAO_OK);
+  EXPECT_EQ(ssao_job_run(job.get()), SSAO_ERROR_INVALID_OPERATION);
+  EXPECT_TRUE(contains(ssao_last_error(), "no output image"));
+  ASSERT_EQ(ssao_job_set_image(job.get(), "ao", small.data(), 2, 2, 1, 0, 0), SSAO_OK);
+  EXPECT_EQ(ssao_job_run(job.get()), SSAO_ERROR_INVALID_ARGUMENT);
+  EXPECT_TRUE(contains(ssao_last_error(), "'ao' is 2x2 but depth is 4x4"));
+  ASSERT_EQ(ssao_job_set_image(job.get(), "ao", nullptr, 0, 0, 1, 0, 0), SSAO_OK);
+  ASSERT_EQ(ssao_job_set_image(job.get(), "composite", rgb.data(), 4, 4, 3, 0, 0), SSAO_OK);
+  EXPECT_EQ(ssao_job_run(job.get()), SSAO_ERROR_INVALID_OPERATION);
+  EXPECT_TRUE(contains(ssao_last_error(), "needs a 'beauty'"));
+  std::vector<float> rgba(64, 0.5f);
+  ASSERT_EQ(ssao_job_set_image(job.get(), "beauty", rgba.data(), 4, 4, 4, 0, 0), SSAO_OK);
+  EXPECT_EQ(ssao_job_run(job.get()), SSAO_ERROR_INVALID_ARGUMENT);
+  EXPECT_TRUE(contains(ssao_last_error(), "channels"));
+}
+
+TEST(Api, EmptyAndSinglePixelImages) {
+  Job job;
+  float value = 5.0f, ao = -1.0f;
+  ASSERT_EQ(ssao_job_set_image(job.get(), "depth", &value, 0, 0, 1, 0, 0), SSAO_OK);
+  ASSERT_EQ(ssao_job_set_image(job.get(), "ao", &ao, 0, 0, 1, 0, 0), SSAO_OK);
+  EXPECT_EQ(ssao_job_run(job.get()), SSAO_OK);  // documented: nothing to do
+  EXPECT_EQ(ao, -1.0f);
+  ASSERT_EQ(ssao_job_set_image(job.get(), "depth", &value, 1, 1, 1, 0, 0), SSAO_OK);
+  ASSERT_EQ(ssao_job_set_image(job.get(), "ao", &ao, 1, 1, 1, 0, 0), SSAO_OK);
+  for (const char* variant : {"hemisphere", "sphere"}) {
+    ASSERT_EQ(ssao_job_set_string(job.get(), "variant", variant), SSAO_OK);
+    EXPECT_EQ(ssao_job_run(job.get()), SSAO_OK);
+    EXPECT_EQ(ao, 1.0f) << variant;  // no neighbour can occlude
+  }
+}
+
+TEST(Api, HostileDepthValuesAreBackground) {
+  const Camera cam;
+  Scene s = floor_and_wall(cam);
+  const float hostile[] = {std::numeric_limits<float>::quiet_NaN(), HUGE_VALF, -HUGE_VALF, -3.0f,
+                           0.0f, 1e10f, 65504.0f, std::numeric_limits<float>::denorm_min()};
+  const size_t n = s.depth.size();
+  for (size_t i = 0; i < n; i += 7) s.depth[i] = hostile[(i / 7) % 8];
+  for (const char* variant : {"hemisphere", "sphere"}) {
+    const auto ao = compute_ao(s, cam, 1.0, variant, true, [](Job& j) {
+      j.set("clip_end", 1000.0);  // makes 65504 (EEVEE's background) background too
+    });
+    for (size_t i = 0; i < n; ++i) {
+      ASSERT_TRUE(std::isfinite(ao[i])) << variant << " pixel " << i;
+      ASSERT_GE(ao[i], 0.0f);
+      ASSERT_LE(ao[i], 1.0f);
+      const float d = s.depth[i];
+      const bool background = !(d > 0) || !std::isfinite(d) || d >= 1000.0f;
+      if (background) {
+        ASSERT_EQ(ao[i], 1.0f) << variant << " depth " << d;
+      }
+    }
+  }
+}
+
+TEST(Api, ZeroAndNonFiniteNormalsFallBackToReconstruction) {
+  const Camera cam;
+  Scene s = floor_and_wall(cam);
+  const auto reference = compute_ao(s, cam, 1.0, "hemisphere", false);
+  std::fill(s.normal.begin(), s.normal.end(), 0.0f);
+  for (size_t i = 0; i < s.normal.size(); i += 5) s.normal[i] = std::nanf("");
+  const auto ao = compute_ao(s, cam, 1.0, "hemisphere", true);
+  // NaN in x with zeros elsewhere is not a direction either: every pixel reconstructs.
+  EXPECT_EQ(ao, reference);
+}
+
+TEST(Api, ResultsDoNotDependOnThreadCount) {
+  const Camera cam;
+  for (const char* variant : {"hemisphere", "sphere"}) {
+    Scene s = floor_and_wall(cam);
+    const auto one = compute_ao(s, cam, 1.0, variant, true, [](Job& j) { j.set("threads", 1); });
+    for (int threads : {2, 3, 7, 0}) {
+      const auto many =
+          compute_ao(s, cam, 1.0, variant, true, [&](Job& j) { j.set("threads", threads); });
+      ASSERT_EQ(std::memcmp(one.data(), many.data(), one.size() * sizeof(float)), 0)
+          << variant << " threads=" << threads;
+    }
+    EXPECT_LT(*std::min_element(one.begin(), one.end()), 0.9f)
+        << "the scene must have occlusion to compare";
+  }
+}
+
+TEST(Api, StridedAndBottomUpImagesGiveTheSameResult) {
+  const Camera cam;
+  Scene s = floor_and_wall(cam);
+  const int w = s.width, h = s.height;
+  const auto packed = compute_ao(s, cam, 1.0, "hemisphere");
+
+  // Depth in channel 3 of an RGBA buffer with padded rows, normals in an RGBA buffer stored
+  // bottom-up (negative row stride), AO written into an RGBA output.
+  const int row_floats = w * 4 + 3;
+  std::vector<float> depth_rgba(size_t(row_floats) * h, 0.0f), normal_up(size_t(w) * h * 4);
+  std::vector<float> ao_rgba(size_t(w) * h * 4, -1.0f);
+  for (int y = 0; y < h; ++y) {
+    for (int x = 0; x < w; ++x) {
+      depth_rgba[size_t(y) * row_floats + x * 4 + 3] = s.depth[size_t(y) * w + x];
+      for (int c = 0; c < 3; ++c) {
+        normal_up[(size_t(h - 1 - y) * w + x) * 4 + c] = s.normal[(size_t(y) * w + x) * 3 + c];
+      }
+    }
+  }
+  Job job;
+  job.camera(cam);
+  job.set("normal_space", "camera");
+  ASSERT_EQ(ssao_job_set_image(job.get(), "depth", depth_rgba.data() + 3, w, h, 1, 16,
+                               row_floats * 4),
+            SSAO_OK);
+  ASSERT_EQ(ssao_job_set_image(job.get(), "normal", normal_up.data() + size_t(h - 1) * w * 4, w,
+                               h, 3, 16, -ptrdiff_t(w) * 16),
+            SSAO_OK);
+  ASSERT_EQ(ssao_job_set_image(job.get(), "ao", ao_rgba.data(), w, h, 4, 0, 0), SSAO_OK);
+  ASSERT_EQ(job.run(), SSAO_OK) << ssao_last_error();
+  for (size_t i = 0; i < packed.size(); ++i) {
+    ASSERT_EQ(ao_rgba[i * 4 + 0], packed[i]);
+    ASSERT_EQ(ao_rgba[i * 4 + 2], packed[i]);
+    ASSERT_EQ(ao_rgba[i * 4 + 3], 1.0f);
+  }
+}
+
+TEST(Api, CompositeIsBeautyTimesAoAndMayBeInPlace) {
+  const Camera cam;
+  Scene s = floor_and_wall(cam);
+  const int w = s.width, h = s.height;
+  const auto ao = compute_ao(s, cam, 1.0, "hemisphere");
+  std::vector<float> beauty(size_t(w) * h * 4);
+  for (size_t i = 0; i < beauty.size(); ++i) beauty[i] = float(i % 13) / 13.0f;
+  const std::vector<float> original = beauty;
+  Job job;
+  job.camera(cam);
+  job.set("normal_space", "camera");
+  job.image("depth", s.depth, w, h, 1);
+  job.image("normal", s.normal, w, h, 3);
+  job.image("beauty", beauty, w, h, 4);
+  job.image("composite", beauty, w, h, 4);  // in place
+  ASSERT_EQ(job.run(), SSAO_OK) << ssao_last_error();
+  for (size_t i = 0; i < ao.size(); ++i) {
+    for (int c = 0; c < 3; ++c) ASSERT_EQ(beauty[i * 4 + c], original[i * 4 + c] * ao[i]);
+    ASSERT_EQ(beauty[i * 4 + 3], original[i * 4 + 3]);  // alpha untouched
+  }
+}
+
+TEST(Api, StrengthPowerAndRemapShapeTheResult) {
+  const Camera cam;
+  Scene s = floor_and_wall(cam);
+  const auto raw = compute_ao(s, cam, 1.0, "hemisphere");
+  const auto none = compute_ao(s, cam, 1.0, "hemisphere", true,
+                               [](Job& j) { j.set("strength", 0.0); });
+  const auto shaped = compute_ao(s, cam, 1.0, "hemisphere", true, [](Job& j) {
+    j.set("power", 2.0);
+    j.set("strength", 0.5);
+    j.set("remap_min", 0.1);
+    j.set("remap_max", 0.6);
+  });
+  for (size_t i = 0; i < raw.size(); ++i) {
+    EXPECT_EQ(none[i], 1.0f);
+    if (!std::isfinite(s.depth[i])) continue;
+    const float expected = 0.1f + 0.5f * (1.0f - 0.5f * (1.0f - raw[i] * raw[i]));
+    EXPECT_NEAR(shaped[i], expected, 1e-6f);
+  }
+}
+
+namespace {
+struct ProgressLog {
+  std::vector<double> values;
+  int cancel_after = -1;
+};
+int record_progress(void* user, double fraction) {
+  auto* log = static_cast<ProgressLog*>(user);
+  log->values.push_back(fraction);
+  return log->cancel_after >= 0 && int(log->values.size()) > log->cancel_after ? 0 : 1;
+}
+}  // namespace
+
+TEST(Api, ProgressIsMonotoneAndCancelLeavesOutputsUntouched) {
+  const Camera cam;
+  Scene s = floor_and_wall(cam);
+  std::vector<float> ao(s.depth.size(), -1.0f);
+  Job job;
+  job.camera(cam);
+  job.set("threads", 2);
+  job.image("depth", s.depth, s.width, s.height, 1);
+  job.image("ao", ao, s.width, s.height, 1);
+  ProgressLog log;
+  ASSERT_EQ(ssao_job_set_progress(job.get(), record_progress, &log), SSAO_OK);
+  ASSERT_EQ(job.run(), SSAO_OK);
+  ASSERT_GT(log.values.size(), 3u);
+  for (size_t i = 1; i < log.values.size(); ++i) EXPECT_GE(log.values[i], log.values[i - 1]);
+  EXPECT_EQ(log.values.back(), 1.0);
+
+  std::vector<float> untouched(s.depth.size(), -1.0f);
+  job.image("ao", untouched, s.width, s.height, 1);
+  ProgressLog cancel;
+  cancel.cancel_after = 3;
+  ASSERT_EQ(ssao_job_set_progress(job.get(), record_progress, &cancel), SSAO_OK);
+  EXPECT_EQ(job.run(), SSAO_ERROR_CANCELLED);
+  for (float v : untouched) ASSERT_EQ(v, -1.0f);
+}
+
+TEST(Api, ErrorMessagesArePerThread) {
+  Job job;
+  ASSERT_EQ(ssao_job_set_float(job.get(), "nope", 1.0), SSAO_ERROR_INVALID_ARGUMENT);
+  std::string other;
+  std::thread t([&] { other = ssao_last_error(); });
+  t.join();
+  EXPECT_EQ(other, "");
+  EXPECT_TRUE(contains(ssao_last_error(), "nope"));
+}
+
+TEST(Api, WorldSpaceNormalsUseTheCameraMatrix) {
+  const Camera cam;
+  Scene s = floor_and_wall(cam);
+  const auto view = compute_ao(s, cam, 1.0, "hemisphere");
+  // Camera rotated 90 degrees about world Z: view-space n = R^T n_world, so world = R n_view.
+  const double m[16] = {0, -1, 0, 3, 1, 0, 0, -2, 0, 0, 1, 1, 0, 0, 0, 1};
+  std::vector<float> world(s.normal.size());
+  for (size_t i = 0; i < world.size(); i += 3) {
+    for (int r = 0; r < 3; ++r) {
+      world[i + r] = float(m[r * 4 + 0] * s.normal[i] + m[r * 4 + 1] * s.normal[i + 1] +
+                           m[r * 4 + 2] * s.normal[i + 2]);
+    }
+  }
+  std::swap(world, s.normal);
+  const auto from_world = compute_ao(s, cam, 1.0, "hemisphere", true, [&](Job& j) {
+    j.set("normal_space", "world");
+    EXPECT_EQ(ssao_job_set_floats(j.get(), "camera_to_world", m, 16), SSAO_OK);
+  });
+  for (size_t i = 0; i < view.size(); ++i) EXPECT_NEAR(from_world[i], view[i], 1e-5f);
+}
