@@ -64,9 +64,10 @@ void check_output_folder(const Options& options) {
     throw ssao_io::Error("cannot write '" + options.output + "': folder '" + folder.string() +
                          "' is not writable");
   }
-  if (!options.quiet && fs::path(options.output).extension() != ".exr") {
-    std::fprintf(stderr, "ssao: warning: '%s' will be an OpenEXR file whatever its extension\n",
-                 options.output.c_str());
+  const std::string extension = fs::path(options.output).extension().string();
+  if (extension != ".exr" && !ssao_io::is_preview_path(options.output)) {
+    throw ssao_io::Error("cannot write '" + options.output + "': use .exr (linear float data) " +
+                         "or .png, .jpg, .tif (an 8-bit sRGB preview)");
   }
 }
 
@@ -101,7 +102,8 @@ void apply_command_line_params(ssao_io::Job& job, const std::vector<ParamSetting
 std::vector<int> channel_indices(const ssao_io::Image& image, const std::vector<std::string>& names,
                                  const std::string& path) {
   std::vector<int> indices;
-  for (const std::string& name : names) indices.push_back(ssao_io::require_channel(image, name, path));
+  for (const std::string& name : names)
+    indices.push_back(ssao_io::require_channel(image, name, path));
   return indices;
 }
 
@@ -123,8 +125,8 @@ Inputs load_inputs(const Options& options) {
                          "channels with --beauty-channels R,G,B[,A]");
   }
 
-  in.depth = ssao_io::extract_channels(in.image, channel_indices(in.image, {in.passes.depth},
-                                                                 options.input));
+  in.depth = ssao_io::extract_channels(in.image,
+                                       channel_indices(in.image, {in.passes.depth}, options.input));
   if (!in.passes.normal.empty()) {
     in.normal = ssao_io::extract_channels(
         in.image, channel_indices(in.image, in.passes.normal, options.input));
@@ -170,9 +172,11 @@ double compute_ao(ssao_io::Job& job, bool quiet) {
 
 // The output file's channels: beauty's (named R, G, B[, A]) x AO then AO, or AO alone.
 void write_output(const Options& options, const Inputs& in, const Outputs& out) {
+  const auto write = ssao_io::is_preview_path(options.output) ? ssao_io::write_preview
+                                                               : ssao_io::write_exr;
   const size_t pixels = in.image.pixel_count();
   if (out.composite.empty()) {
-    ssao_io::write_exr(options.output, in.image.width, in.image.height, {"AO"}, out.ao);
+    write(options.output, in.image.width, in.image.height, {"AO"}, out.ao);
     return;
   }
   std::vector<std::string> names = {"R", "G", "B", "A"};
@@ -185,7 +189,7 @@ void write_output(const Options& options, const Inputs& in, const Outputs& out) 
     for (size_t c = 0; c < beauty; ++c) interleaved[p * stride + c] = out.composite[p * beauty + c];
     interleaved[p * stride + beauty] = out.ao[p];
   }
-  ssao_io::write_exr(options.output, in.image.width, in.image.height, names, interleaved);
+  write(options.output, in.image.width, in.image.height, names, interleaved);
 }
 
 // The same test as the core's: finite, > 0, below background_depth and clip_end (when > 0).

@@ -14,40 +14,6 @@
 namespace ssao_cli {
 namespace {
 
-// Front-end options (not core parameters). The table drives parsing, --help and suggestions.
-struct FrontOption {
-  enum Group { kInputOutput, kOther };
-  Group group;
-  const char* flag;
-  const char* alias;    // short form or nullptr
-  const char* metavar;  // nullptr for a switch
-  const char* help;
-};
-
-const std::vector<FrontOption>& front_options() {
-  static const std::vector<FrontOption> options = {
-      {FrontOption::kInputOutput, "--output", "-o", "OUT.exr",
-       "output file (required), always OpenEXR, float, ZIP; written to a temporary file and "
-       "renamed, never over IN.exr"},
-      {FrontOption::kInputOutput, "--camera", nullptr, "CAM.json",
-       "camera description (required): Blender camera properties and matrix_world, see "
-       "docs/conventions"},
-      {FrontOption::kInputOutput, "--ao-only", nullptr, nullptr, "write exactly one channel, AO, instead of beauty x AO + AO"},
-      {FrontOption::kInputOutput, "--layer", nullptr, "NAME", "view layer to read when several have a Depth pass"},
-      {FrontOption::kInputOutput, "--depth-channel", nullptr, "NAME",
-       "depth channel (default <layer>.Depth.Z, or Depth.Z, Z, depth, Depth without layers)"},
-      {FrontOption::kInputOutput, "--normal-channels", nullptr, "X,Y,Z",
-       "normal channels (default <layer>.Normal.X,Y,Z, or Normal.* / N.* without layers)"},
-      {FrontOption::kInputOutput, "--beauty-channels", nullptr, "R,G,B[,A]",
-       "beauty channels (default <layer>.Combined.R,G,B[,A], or Combined.* / R,G,B[,A])"},
-      {FrontOption::kInputOutput, "--no-normals", nullptr, nullptr, "ignore the normal pass; reconstruct normals from depth"},
-      {FrontOption::kOther, "--quiet", "-q", nullptr, "no progress, no summary, no warnings (errors are still shown)"},
-      {FrontOption::kOther, "--help", "-h", nullptr, "print this help and exit"},
-      {FrontOption::kOther, "--version", nullptr, nullptr, "print the library version and exit"},
-  };
-  return options;
-}
-
 std::vector<std::string> split(const std::string& text, char separator) {
   std::vector<std::string> parts;
   size_t start = 0;
@@ -59,11 +25,81 @@ std::vector<std::string> split(const std::string& text, char separator) {
   }
 }
 
+std::vector<std::string> parse_channel_list(const std::string& flag, const std::string& text,
+                                            size_t min_count, size_t max_count) {
+  const std::vector<std::string> names = split(text, ',');
+  for (const std::string& name : names) {
+    if (name.empty()) throw UsageError(flag + ": empty channel name in '" + text + "'");
+  }
+  if (names.size() < min_count || names.size() > max_count) {
+    const std::string expected =
+        min_count == max_count ? std::to_string(min_count)
+                               : std::to_string(min_count) + " or " + std::to_string(max_count);
+    throw UsageError(flag + " expects " + expected + " comma-separated channel names, got " +
+                     std::to_string(names.size()) + " in '" + text + "'");
+  }
+  return names;
+}
+
+// Front-end options (not core parameters). The table drives parsing, --help and suggestions.
+struct FrontOption {
+  enum Group { kInputOutput, kOther };
+  Group group;
+  const char* flag;
+  const char* alias;    // short form or nullptr
+  const char* metavar;  // nullptr for a switch
+  const char* help;
+  void (*apply)(Options& out, const std::string& flag, const std::string& value);
+};
+
+const std::vector<FrontOption>& front_options() {
+  static const std::vector<FrontOption> options = {
+      {FrontOption::kInputOutput, "--output", "-o", "OUT.exr",
+       "output file (required): .exr writes float data (ZIP); .png, .jpg or .tif an 8-bit sRGB "
+       "preview; written to a temporary file and renamed, never over IN.exr",
+       [](Options& o, const std::string&, const std::string& v) { o.output = v; }},
+      {FrontOption::kInputOutput, "--camera", nullptr, "CAM.json",
+       "camera description (required): Blender camera properties and matrix_world, see "
+       "docs/conventions.md",
+       [](Options& o, const std::string&, const std::string& v) { o.camera = v; }},
+      {FrontOption::kInputOutput, "--ao-only", nullptr, nullptr,
+       "write exactly one channel, AO, instead of beauty x AO + AO",
+       [](Options& o, const std::string&, const std::string&) { o.ao_only = true; }},
+      {FrontOption::kInputOutput, "--layer", nullptr, "NAME",
+       "view layer to read when several have a Depth pass",
+       [](Options& o, const std::string&, const std::string& v) { o.layer = v; }},
+      {FrontOption::kInputOutput, "--depth-channel", nullptr, "NAME",
+       "depth channel (default <layer>.Depth.Z, or Depth.Z, Z, depth, Depth without layers)",
+       [](Options& o, const std::string&, const std::string& v) { o.depth_channel = v; }},
+      {FrontOption::kInputOutput, "--normal-channels", nullptr, "X,Y,Z",
+       "normal channels (default <layer>.Normal.X,Y,Z, or Normal.* / N.* without layers)",
+       [](Options& o, const std::string& f, const std::string& v) {
+         o.normal_channels = parse_channel_list(f, v, 3, 3);
+       }},
+      {FrontOption::kInputOutput, "--beauty-channels", nullptr, "R,G,B[,A]",
+       "beauty channels (default <layer>.Combined.R,G,B[,A], or Combined.* / R,G,B[,A])",
+       [](Options& o, const std::string& f, const std::string& v) {
+         o.beauty_channels = parse_channel_list(f, v, 3, 4);
+       }},
+      {FrontOption::kInputOutput, "--no-normals", nullptr, nullptr,
+       "ignore the normal pass; reconstruct normals from depth",
+       [](Options& o, const std::string&, const std::string&) { o.no_normals = true; }},
+      {FrontOption::kOther, "--quiet", "-q", nullptr,
+       "no progress, no summary, no warnings (errors are still shown)",
+       [](Options& o, const std::string&, const std::string&) { o.quiet = true; }},
+      {FrontOption::kOther, "--help", "-h", nullptr, "print this help and exit",
+       [](Options& o, const std::string&, const std::string&) { o.help = true; }},
+      {FrontOption::kOther, "--version", nullptr, nullptr, "print the library version and exit",
+       [](Options& o, const std::string&, const std::string&) { o.version = true; }},
+  };
+  return options;
+}
+
 // Integers as integers (2147483647, not 2.14748e+09), other numbers in %g.
 std::string format_number(double value, bool integer) {
   if (std::isinf(value)) return value > 0 ? "inf" : "-inf";
   char buffer[64];
-  if (integer || (value == std::floor(value) && std::fabs(value) < 1e7)) {
+  if (integer || (value == std::floor(value) && std::fabs(value) < 1e6)) {
     std::snprintf(buffer, sizeof buffer, "%.0f", value);
   } else {
     std::snprintf(buffer, sizeof buffer, "%g", value);
@@ -91,7 +127,8 @@ double parse_float(const std::string& flag, const std::string& text) {
   if (text.empty() || std::isspace(static_cast<unsigned char>(text[0])) || *end != '\0') {
     throw UsageError(flag + " expects a number, got '" + text + "'");
   }
-  if (!std::isfinite(value)) throw UsageError(flag + " expects a finite number, got '" + text + "'");
+  if (!std::isfinite(value))
+    throw UsageError(flag + " expects a finite number, got '" + text + "'");
   return value;
 }
 
@@ -103,12 +140,8 @@ ParamSetting parse_param(const ssao_param_desc& desc, const std::string& flag,
   setting.text = text;
   setting.type = desc.type;
   switch (desc.type) {
-    case SSAO_PARAM_INT:
-      setting.int_value = parse_int(flag, text);
-      break;
-    case SSAO_PARAM_FLOAT:
-      setting.float_value = parse_float(flag, text);
-      break;
+    case SSAO_PARAM_INT: setting.int_value = parse_int(flag, text); break;
+    case SSAO_PARAM_FLOAT: setting.float_value = parse_float(flag, text); break;
     case SSAO_PARAM_STRING: {
       const std::vector<std::string> choices = split(desc.choices ? desc.choices : "", '|');
       if (std::find(choices.begin(), choices.end(), text) == choices.end()) {
@@ -129,22 +162,6 @@ ParamSetting parse_param(const ssao_param_desc& desc, const std::string& flag,
     }
   }
   return setting;
-}
-
-std::vector<std::string> parse_channel_list(const std::string& flag, const std::string& text,
-                                            size_t min_count, size_t max_count) {
-  const std::vector<std::string> names = split(text, ',');
-  for (const std::string& name : names) {
-    if (name.empty()) throw UsageError(flag + ": empty channel name in '" + text + "'");
-  }
-  if (names.size() < min_count || names.size() > max_count) {
-    const std::string expected = min_count == max_count
-                                     ? std::to_string(min_count)
-                                     : std::to_string(min_count) + " or " + std::to_string(max_count);
-    throw UsageError(flag + " expects " + expected + " comma-separated channel names, got " +
-                     std::to_string(names.size()) + " in '" + text + "'");
-  }
-  return names;
 }
 
 size_t edit_distance(const std::string& a, const std::string& b) {
@@ -194,21 +211,6 @@ const ssao_param_desc* find_param(const std::string& flag,
     if (flag == flag_for(desc.name)) return &desc;
   }
   return nullptr;
-}
-
-void apply_front_option(const FrontOption& option, const std::string& value, Options& out) {
-  const std::string flag = option.flag;
-  if (flag == "--output") out.output = value;
-  else if (flag == "--camera") out.camera = value;
-  else if (flag == "--layer") out.layer = value;
-  else if (flag == "--depth-channel") out.depth_channel = value;
-  else if (flag == "--normal-channels") out.normal_channels = parse_channel_list(flag, value, 3, 3);
-  else if (flag == "--beauty-channels") out.beauty_channels = parse_channel_list(flag, value, 3, 4);
-  else if (flag == "--ao-only") out.ao_only = true;
-  else if (flag == "--no-normals") out.no_normals = true;
-  else if (flag == "--quiet") out.quiet = true;
-  else if (flag == "--help") out.help = true;
-  else if (flag == "--version") out.version = true;
 }
 
 void require_complete(const Options& options) {
@@ -274,7 +276,8 @@ std::string param_facts(const ssao_param_desc& desc) {
       if (std::isinf(desc.max_value)) {
         facts += ", range >= " + format_number(desc.min_value, integer);
       } else {
-        facts += ", range " + format_number(desc.min_value, integer) + ".." + format_number(desc.max_value, integer);
+        facts += ", range " + format_number(desc.min_value, integer) + ".." +
+                 format_number(desc.max_value, integer);
       }
       break;
     case SSAO_PARAM_STRING:
@@ -350,7 +353,7 @@ Options parse_args(int argc, const char* const* argv, const std::vector<ssao_par
     const bool takes_value = param != nullptr || option->metavar != nullptr;
     if (!takes_value) {
       if (has_inline_value) throw UsageError(flag + " takes no value");
-      apply_front_option(*option, "", out);
+      option->apply(out, option->flag, "");
       continue;
     }
     if (!has_inline_value) {
@@ -361,7 +364,7 @@ Options parse_args(int argc, const char* const* argv, const std::vector<ssao_par
       out.params.push_back(parse_param(*param, flag, value));
     } else {
       if (value.empty()) throw UsageError(flag + " requires a non-empty value");
-      apply_front_option(*option, value, out);
+      option->apply(out, option->flag, value);
     }
   }
   require_complete(out);
@@ -383,7 +386,8 @@ std::string usage_text(const std::vector<ssao_param_desc>& table) {
     if (group == FrontOption::kOther) text += "\nOther:\n";
     for (const FrontOption& option : front_options()) {
       if (option.group != group) continue;
-      std::string left = option.alias ? std::string(option.alias) + ", " + option.flag : option.flag;
+      std::string left =
+          option.alias ? std::string(option.alias) + ", " + option.flag : option.flag;
       if (option.metavar) left += std::string(" ") + option.metavar;
       text += help_entry(left, option.help);
     }
@@ -398,12 +402,14 @@ std::string usage_text(const std::vector<ssao_param_desc>& table) {
                          description + " [" + param_facts(desc) + "]");
     }
   };
-  param_section("AO parameters (libssao's parameter table; --NAME_WITH_UNDERSCORES is written "
-                "with dashes):",
-                false);
-  param_section("Camera parameters (set from --camera CAM.json, matrix_world giving\n"
-                "camera_to_world; a flag given here overrides the file):",
-                true);
+  param_section(
+      "AO parameters (libssao's parameter table; --NAME_WITH_UNDERSCORES is written "
+      "with dashes):",
+      false);
+  param_section(
+      "Camera parameters (set from --camera CAM.json, matrix_world giving\n"
+      "camera_to_world; a flag given here overrides the file):",
+      true);
 
   text +=
       "\n"

@@ -81,8 +81,8 @@ std::string choose_layer_and_depth(const std::vector<std::string>& channels,
     return overrides.layer;
   }
   if (layers.size() > 1) {
-    throw Error("'" + file + "' has several view layers with a depth pass: " +
-                join_names(layers) + "; choose one with --layer");
+    throw Error("'" + file + "' has several view layers with a depth pass: " + join_names(layers) +
+                "; choose one with --layer");
   }
   if (layers.size() == 1) {
     out.depth = layers.front() + kDepthSuffix;

@@ -31,10 +31,10 @@ struct PassOverrides {
 };
 
 struct PassChannels {
-  std::string layer;                         // "" for a file without layers
-  std::string depth;                         // always set
-  std::vector<std::string> normal;           // empty or X, Y, Z
-  std::vector<std::string> beauty;           // empty or R, G, B[, A]
+  std::string layer;                // "" for a file without layers
+  std::string depth;                // always set
+  std::vector<std::string> normal;  // empty or X, Y, Z
+  std::vector<std::string> beauty;  // empty or R, G, B[, A]
 };
 
 // The view layers that have a depth pass ("<layer>.Depth.Z"), in channel order.

@@ -1,11 +1,10 @@
 // SPDX-License-Identifier: MIT
 #include "io/camera_json.h"
 
-#include <nlohmann/json.hpp>
-
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <nlohmann/json.hpp>
 #include <sstream>
 
 #include "io/job.h"
@@ -33,7 +32,8 @@ class Reader {
   }
 
   double finite_number(const Json& value, const std::string& key) const {
-    if (!value.is_number()) fail(key, std::string("must be a number, got ") + json_type_name(value));
+    if (!value.is_number())
+      fail(key, std::string("must be a number, got ") + json_type_name(value));
     const double number = value.get<double>();
     if (!std::isfinite(number)) fail(key, "must be a finite number");
     return number;
@@ -93,8 +93,8 @@ class Reader {
 
 const std::vector<std::string>& known_keys() {
   static const std::vector<std::string> keys = {
-      "type",        "lens",        "sensor_width", "sensor_height",  "sensor_fit",
-      "shift_x",     "shift_y",     "ortho_scale",  "clip_start",     "clip_end",
+      "type",         "lens",           "sensor_width",  "sensor_height", "sensor_fit",
+      "shift_x",      "shift_y",        "ortho_scale",   "clip_start",    "clip_end",
       "matrix_world", "pixel_aspect_x", "pixel_aspect_y"};
   return keys;
 }
@@ -154,8 +154,8 @@ Camera read_camera_json(const std::string& path) {
 
 const std::vector<std::string>& camera_param_names() {
   static const std::vector<std::string> names = {
-      "camera_type", "lens",       "sensor_width", "sensor_height", "sensor_fit",
-      "shift_x",     "shift_y",    "ortho_scale",  "clip_start",    "clip_end",
+      "camera_type",    "lens",           "sensor_width",   "sensor_height", "sensor_fit",
+      "shift_x",        "shift_y",        "ortho_scale",    "clip_start",    "clip_end",
       "pixel_aspect_x", "pixel_aspect_y", "camera_to_world"};
   return names;
 }

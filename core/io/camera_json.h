@@ -20,16 +20,16 @@
 namespace ssao_io {
 
 struct Camera {
-  std::string type = "PERSP";  // "PERSP" | "ORTHO"
-  double lens = 50.0;          // mm
-  double sensor_width = 36.0;  // mm
-  double sensor_height = 24.0; // mm
+  std::string type = "PERSP";       // "PERSP" | "ORTHO"
+  double lens = 50.0;               // mm
+  double sensor_width = 36.0;       // mm
+  double sensor_height = 24.0;      // mm
   std::string sensor_fit = "AUTO";  // "AUTO" | "HORIZONTAL" | "VERTICAL"
   double shift_x = 0.0;
   double shift_y = 0.0;
   double ortho_scale = 6.0;
   double clip_start = 0.1;
-  double clip_end = 1000.0;  // Blender's default since 2.80 (it was 100 before)
+  double clip_end = 1000.0;
   double pixel_aspect_x = 1.0;
   double pixel_aspect_y = 1.0;
   std::array<double, 16> matrix_world = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};

@@ -1,13 +1,15 @@
 // SPDX-License-Identifier: MIT
 #include "io/image_io.h"
 
+
 #include <fcntl.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
-#include <OpenImageIO/imageio.h>
-
+#include <algorithm>
+#include <cctype>
 #include <cerrno>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -16,6 +18,8 @@
 #include <memory>
 #include <new>
 #include <system_error>
+
+#include <OpenImageIO/imageio.h>
 
 namespace fs = std::filesystem;
 
@@ -132,7 +136,8 @@ Image read_image(const std::string& path) {
   }
   const OIIO::ImageSpec spec = input->spec();
   if (spec.deep) throw Error("cannot read " + quoted(path) + ": deep images are not supported");
-  if (spec.depth > 1) throw Error("cannot read " + quoted(path) + ": volume images are not supported");
+  if (spec.depth > 1)
+    throw Error("cannot read " + quoted(path) + ": volume images are not supported");
   if (spec.x != spec.full_x || spec.y != spec.full_y || spec.width != spec.full_width ||
       spec.height != spec.full_height) {
     throw Error("cannot read " + quoted(path) + ": its data window (" + std::to_string(spec.width) +
@@ -154,8 +159,8 @@ Image read_image(const std::string& path) {
                 std::to_string(spec.width) + " x " + std::to_string(spec.height) + " x " +
                 std::to_string(spec.nchannels) + " floats");
   }
-  const bool ok = input->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT,
-                                    image.pixels.data());
+  const bool ok =
+      input->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, image.pixels.data());
   const std::string error = input->geterror();
   input->close();
   if (!ok) {
@@ -168,8 +173,8 @@ Image read_image(const std::string& path) {
 int require_channel(const Image& image, const std::string& name, const std::string& path) {
   const int index = image.find_channel(name);
   if (index < 0) {
-    throw Error(quoted(path) + " has no channel " + quoted(name) + "; its channels are: " +
-                join_names(image.channel_names));
+    throw Error(quoted(path) + " has no channel " + quoted(name) +
+                "; its channels are: " + join_names(image.channel_names));
   }
   return index;
 }
@@ -186,20 +191,51 @@ std::vector<float> extract_channels(const Image& image, const std::vector<int>& 
   return out;
 }
 
-void write_exr(const std::string& path, int width, int height,
-               const std::vector<std::string>& channel_names, const std::vector<float>& pixels) {
-  const int channels = static_cast<int>(channel_names.size());
+namespace {
+
+void check_image_buffer(const std::string& path, int width, int height, int channels,
+                        size_t float_count) {
   if (width <= 0 || height <= 0 || channels <= 0) {
-    throw Error("cannot write " + quoted(path) + ": empty image (" + std::to_string(width) +
-                " x " + std::to_string(height) + " x " + std::to_string(channels) + " channels)");
+    throw Error("cannot write " + quoted(path) + ": empty image (" + std::to_string(width) + " x " +
+                std::to_string(height) + " x " + std::to_string(channels) + " channels)");
   }
-  if (pixels.size() != checked_float_count(width, height, channels, path)) {
+  if (float_count != checked_float_count(width, height, channels, path)) {
     throw Error("cannot write " + quoted(path) + ": internal error: pixel buffer has " +
-                std::to_string(pixels.size()) + " floats for " + std::to_string(width) + " x " +
+                std::to_string(float_count) + " floats for " + std::to_string(width) + " x " +
                 std::to_string(height) + " x " + std::to_string(channels));
   }
   if (fs::is_directory(path)) throw Error("cannot write " + quoted(path) + ": it is a directory");
+}
 
+// Writes through a temporary file in the same folder, renamed into place once complete.
+void write_atomically(const std::string& path, const char* format, const OIIO::ImageSpec& spec,
+                      OIIO::TypeDesc data_type, const void* data) {
+  TemporaryFile temporary(path);
+  auto output = OIIO::ImageOutput::create(format);
+  if (!output) {
+    throw Error("cannot write " + quoted(path) + ": no " + format + " writer (" +
+                oiio_detail(OIIO::geterror()) + ")");
+  }
+  bool ok = output->open(temporary.path(), spec) && output->write_image(data_type, data);
+  ok = output->close() && ok;
+  if (!ok) {
+    throw Error("cannot write " + quoted(path) + ": " + oiio_detail(output->geterror()));
+  }
+  temporary.commit(path);
+}
+
+// The sRGB transfer function (IEC 61966-2-1) applied to linear scene values clamped to [0, 1].
+float srgb_encode(float linear) {
+  const float v = std::clamp(std::isfinite(linear) ? linear : 0.0f, 0.0f, 1.0f);
+  return v <= 0.0031308f ? 12.92f * v : 1.055f * std::pow(v, 1.0f / 2.4f) - 0.055f;
+}
+
+}  // namespace
+
+void write_exr(const std::string& path, int width, int height,
+               const std::vector<std::string>& channel_names, const std::vector<float>& pixels) {
+  const int channels = static_cast<int>(channel_names.size());
+  check_image_buffer(path, width, height, channels, pixels.size());
   OIIO::ImageSpec spec(width, height, channels, OIIO::TypeDesc::FLOAT);
   spec.channelnames = channel_names;
   spec.alpha_channel = -1;
@@ -207,20 +243,59 @@ void write_exr(const std::string& path, int width, int height,
     if (channel_names[static_cast<size_t>(c)] == "A") spec.alpha_channel = c;
   }
   spec.attribute("compression", "zip");
+  write_atomically(path, "openexr", spec, OIIO::TypeDesc::FLOAT, pixels.data());
+}
 
-  TemporaryFile temporary(path);
-  auto output = OIIO::ImageOutput::create("openexr");
-  if (!output) {
-    throw Error("cannot write " + quoted(path) + ": no OpenEXR writer (" +
-                oiio_detail(OIIO::geterror()) + ")");
+void write_preview(const std::string& path, int width, int height,
+                   const std::vector<std::string>& channel_names,
+                   const std::vector<float>& pixels) {
+  const int channels = static_cast<int>(channel_names.size());
+  check_image_buffer(path, width, height, channels, pixels.size());
+  auto index_of = [&](const char* name) {
+    const auto it = std::find(channel_names.begin(), channel_names.end(), name);
+    return it == channel_names.end() ? -1 : static_cast<int>(it - channel_names.begin());
+  };
+  // Colour if there is R, G, B (and A); otherwise the AO (or first) channel as grey.
+  std::vector<int> picked;
+  for (const char* name : {"R", "G", "B"}) {
+    if (index_of(name) >= 0) picked.push_back(index_of(name));
   }
-  bool ok = output->open(temporary.path(), spec) &&
-            output->write_image(OIIO::TypeDesc::FLOAT, pixels.data());
-  ok = output->close() && ok;
-  if (!ok) {
-    throw Error("cannot write " + quoted(path) + ": " + oiio_detail(output->geterror()));
+  if (picked.size() != 3) picked = {std::max(0, index_of("AO"))};
+  const int alpha = picked.size() == 3 ? index_of("A") : -1;
+  const int out_channels = static_cast<int>(picked.size()) + (alpha >= 0 ? 1 : 0);
+
+  const std::string extension = fs::path(path).extension().string();
+  std::string format = extension.empty() ? "" : extension.substr(1);
+  std::transform(format.begin(), format.end(), format.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  if (format == "jpg") format = "jpeg";
+  if (format == "tif") format = "tiff";
+
+  const size_t count = static_cast<size_t>(width) * static_cast<size_t>(height);
+  std::vector<unsigned char> bytes(count * static_cast<size_t>(out_channels));
+  for (size_t p = 0; p < count; ++p) {
+    const float* in = pixels.data() + p * static_cast<size_t>(channels);
+    unsigned char* out = bytes.data() + p * static_cast<size_t>(out_channels);
+    for (size_t k = 0; k < picked.size(); ++k) {
+      out[k] = static_cast<unsigned char>(std::lround(255.0f * srgb_encode(in[picked[k]])));
+    }
+    if (alpha >= 0) {
+      const float a = std::isfinite(in[alpha]) ? std::clamp(in[alpha], 0.0f, 1.0f) : 1.0f;
+      out[picked.size()] = static_cast<unsigned char>(std::lround(255.0f * a));
+    }
   }
-  temporary.commit(path);
+  OIIO::ImageSpec spec(width, height, out_channels, OIIO::TypeDesc::UINT8);
+  spec.alpha_channel = alpha >= 0 ? out_channels - 1 : -1;
+  spec.attribute("oiio:ColorSpace", "sRGB");
+  write_atomically(path, format.c_str(), spec, OIIO::TypeDesc::UINT8, bytes.data());
+}
+
+bool is_preview_path(const std::string& path) {
+  std::string extension = fs::path(path).extension().string();
+  std::transform(extension.begin(), extension.end(), extension.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  return extension == ".png" || extension == ".jpg" || extension == ".jpeg" ||
+         extension == ".tif" || extension == ".tiff";
 }
 
 }  // namespace ssao_io

@@ -46,6 +46,15 @@ std::vector<float> extract_channels(const Image& image, const std::vector<int>& 
 void write_exr(const std::string& path, int width, int height,
                const std::vector<std::string>& channel_names, const std::vector<float>& pixels);
 
+// Writes a display-referred 8-bit preview (PNG, JPEG or TIFF by the extension of `path`): R, G,
+// B (and A) if those channels exist, otherwise the AO channel (or the first) as grey; colour
+// and AO values clamped to [0, 1] and sRGB-encoded, alpha kept linear. Atomic like write_exr.
+void write_preview(const std::string& path, int width, int height,
+                   const std::vector<std::string>& channel_names, const std::vector<float>& pixels);
+
+// True for the extensions write_preview handles (.png, .jpg, .jpeg, .tif, .tiff).
+bool is_preview_path(const std::string& path);
+
 // Comma-separated list of the names, for messages: "R, G, B".
 std::string join_names(const std::vector<std::string>& names, const char* separator = ", ");
 

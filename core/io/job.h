@@ -94,8 +94,8 @@ class Job {
   // Attaches a caller-owned image (see ssao_job_set_image); strides in bytes, 0 = packed.
   void set_image(const std::string& name, float* data, int width, int height, int channels,
                  std::ptrdiff_t pixel_stride = 0, std::ptrdiff_t row_stride = 0) {
-    check_status(ssao_job_set_image(job_, name.c_str(), data, width, height, channels,
-                                    pixel_stride, row_stride),
+    check_status(ssao_job_set_image(job_, name.c_str(), data, width, height, channels, pixel_stride,
+                                    row_stride),
                  "image " + name);
   }
   void set_progress(ssao_progress_fn fn, void* user) {

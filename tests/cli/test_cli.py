@@ -112,15 +112,15 @@ def read_exr(path):
     return list(spec.channelnames), pixels.reshape(spec.height, spec.width, spec.nchannels)
 
 
-def core_param_names():
-    """The parameter names of the core's table, read through the C API with ctypes."""
+def dump_core_table(lib_path):
+    """Prints {"names": [...], "version": N} read from libssao through the C API (ctypes)."""
     class ParamDesc(ctypes.Structure):
         _fields_ = [("name", ctypes.c_char_p), ("type", ctypes.c_int),
                     ("default_value", ctypes.c_double), ("min_value", ctypes.c_double),
                     ("max_value", ctypes.c_double), ("default_string", ctypes.c_char_p),
                     ("choices", ctypes.c_char_p), ("count", ctypes.c_size_t),
                     ("unit", ctypes.c_char_p), ("description", ctypes.c_char_p)]
-    lib = ctypes.CDLL(LIB)
+    lib = ctypes.CDLL(lib_path)
     lib.ssao_param_count.restype = ctypes.c_size_t
     lib.ssao_param_info.argtypes = [ctypes.c_size_t, ctypes.POINTER(ParamDesc)]
     names = []
@@ -128,7 +128,18 @@ def core_param_names():
         desc = ParamDesc()
         assert lib.ssao_param_info(i, ctypes.byref(desc)) == 0
         names.append(desc.name.decode())
-    return names, lib.ssao_version()
+    print(json.dumps({"names": names, "version": lib.ssao_version()}))
+
+
+def core_param_names():
+    """(parameter names, ssao_version()) of the core. Read in a child process, so that a library
+    built with -DSSAO_SANITIZE=ON can be loaded (ASan must otherwise come first in Python)."""
+    env = dict(os.environ, ASAN_OPTIONS="verify_asan_link_order=0:detect_leaks=0")
+    proc = subprocess.run([sys.executable, os.path.abspath(__file__), "--dump-core-table", LIB],
+                          capture_output=True, text=True, env=env, timeout=60)
+    assert proc.returncode == 0, proc.stderr
+    table = json.loads(proc.stdout)
+    return table["names"], table["version"]
 
 
 class CliTestCase(unittest.TestCase):
@@ -235,7 +246,8 @@ class GoodRunTest(CliTestCase):
         np.testing.assert_array_equal(ao_only[:, :, 0], full[:, :, names.index("AO")])
 
     def test_without_alpha_writes_rgb_and_ao(self):
-        write_exr(self.input, self.planes, [n for n in BLENDER_CHANNELS if n != "ViewLayer.Combined.A"])
+        write_exr(self.input, self.planes,
+                  [n for n in BLENDER_CHANNELS if n != "ViewLayer.Combined.A"])
         self.assert_ok(self.run_ssao())
         names, _ = read_exr(self.output)
         self.assertEqual(sorted(names), ["AO", "B", "G", "R"])
@@ -470,6 +482,9 @@ class BadInputTest(CliTestCase):
 
 def main():
     global SSAO, LIB, SCRATCH
+    if len(sys.argv) == 3 and sys.argv[1] == "--dump-core-table":
+        dump_core_table(sys.argv[2])
+        return
     parser = argparse.ArgumentParser(add_help=False)
     parser.add_argument("--ssao", default=SSAO)
     parser.add_argument("--lib", default=LIB)

@@ -1,0 +1,37 @@
+#!/usr/bin/env bash
+# SPDX-License-Identifier: MIT
+# Installs the Debian 12 packages the project needs, only those that are missing.
+set -euo pipefail
+
+PACKAGES=(
+  g++ cmake ninja-build pkg-config          # build
+  libgtest-dev                              # unit tests
+  libopenimageio-dev openimageio-tools      # EXR I/O of the command-line tool
+  libopenexr-dev nlohmann-json3-dev
+  python3-numpy python3-openimageio         # Python test helpers (/usr/bin/python3)
+  blender                                   # ground truth renders (Cycles AO pass)
+)
+
+missing=()
+for package in "${PACKAGES[@]}"; do
+  status=$(dpkg-query -W -f='${Status}' "$package" 2>/dev/null || true)
+  [[ "$status" == "install ok installed" ]] || missing+=("$package")
+done
+if [[ ${#missing[@]} -eq 0 ]]; then
+  echo "install_deps: all ${#PACKAGES[@]} packages present"
+  exit 0
+fi
+
+SUDO=()
+if [[ $(id -u) -ne 0 ]]; then
+  if command -v sudo >/dev/null; then
+    SUDO=(sudo)
+  else
+    echo "install_deps: run as root: apt-get install ${missing[*]}" >&2
+    exit 1
+  fi
+fi
+echo "install_deps: installing ${missing[*]}"
+export DEBIAN_FRONTEND=noninteractive
+"${SUDO[@]}" apt-get update -q
+"${SUDO[@]}" apt-get install -y -q --no-install-recommends "${missing[@]}"

@@ -1,0 +1,646 @@
+// SPDX-License-Identifier: MIT
+// ssao_eval: scores an AO method against the ray-traced AO pass of a Blender render.
+//
+//   ssao_eval SCENE.exr --camera CAM.json --radius R --method M [options]
+//
+// Methods: "ssao" (libssao through the C API, configured with --set name=value), and the
+// references of tests/reference: "seed-hemisphere", "seed-sphere" (ports of the seed tutorials'
+// code) and "raymarch" (brute-force depth-buffer ray march). The score is the RMSE and the mean
+// signed error (method - truth) of the AO over the pixels whose depth is finite, > 0 and
+// < 0.9 * clip_end, against the file's "<layer>.AO.R" channel (Cycles' AO pass). Run with --help
+// for the options. Exit status: 0 success, 1 a failed check (--max-rmse, --compare-to) or an
+// unreadable input, 2 a command-line mistake.
+#include <algorithm>
+#include <array>
+#include <chrono>
+#include <cerrno>
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <cstdlib>
+#include <exception>
+#include <filesystem>
+#include <functional>
+#include <limits>
+#include <memory>
+#include <new>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "camera.h"  // core/src (through ssao_reference): the camera model of the references
+#include "io/blender_passes.h"
+#include "io/camera_json.h"
+#include "io/image_io.h"
+#include "io/job.h"
+#include "reference_ao.h"
+
+namespace {
+
+constexpr const char* kProgram = "ssao_eval";
+
+// A command-line mistake: exit status 2.
+class UsageError : public std::runtime_error {
+ public:
+  explicit UsageError(const std::string& message) : std::runtime_error(message) {}
+};
+
+const char* const kUsage =
+    "Usage: ssao_eval SCENE.exr --camera CAM.json --radius R --method M [options]\n"
+    "\n"
+    "Scores an AO method against the ray-traced AO pass (<layer>.AO.R) of a Blender multilayer\n"
+    "EXR with Depth (and optionally Normal) passes. Prints one line per method:\n"
+    "  scene=... method=... settings=... normals=pass|depth rmse=... mean_error=... time_ms=...\n"
+    "  repeat=N threads=T pixels=P\n"
+    "over the pixels whose depth is finite, > 0 and < 0.9 * clip_end. mean_error is the mean\n"
+    "of (method - truth): positive means too little occlusion. time_ms is the best of --repeat\n"
+    "runs of the AO computation alone (no file I/O).\n"
+    "\n"
+    "Methods:\n"
+    "  ssao             libssao through its C API; world-space normals from the Normal pass\n"
+    "                   with the camera's matrix_world. --set takes any core parameter\n"
+    "                   (variant, samples, steps, bias, denoise, threads, ...)\n"
+    "  seed-hemisphere  port of the seed normal-oriented hemisphere tutorial (--set samples=N,\n"
+    "                   seed=N)\n"
+    "  seed-sphere      port of the seed Crysis sphere code (--set samples=N, seed=N)\n"
+    "  raymarch         brute-force ray march through the depth buffer (--set rays=N,\n"
+    "                   steps=N, thickness=F (fraction of radius), seed=N)\n"
+    "\n"
+    "Options:\n"
+    "  --camera FILE        camera JSON (required)\n"
+    "  --radius R           AO distance in scene units, as Cycles' (required)\n"
+    "  --method M           method to score (required)\n"
+    "  --set NAME=VALUE     parameter of the method (repeatable); arrays as a,b,c\n"
+    "  --repeat N           time N runs and report the fastest (default 1)\n"
+    "  --max-rmse X         exit 1 if the RMSE is above X\n"
+    "  --compare-to M2      also score M2 (with its defaults and --compare-set) and exit 1\n"
+    "                       unless RMSE(M) < RMSE(M2) * (1 - margin)\n"
+    "  --compare-set N=V    parameter of M2 (repeatable)\n"
+    "  --margin F           relative margin of --compare-to, in [0, 1) (default 0)\n"
+    "  --write-ao OUT.exr   write the AO of M (channel AO) to OUT.exr\n"
+    "  --layer NAME         view layer to read when the file has several\n"
+    "  --no-normals         ignore the Normal pass: every method reconstructs normals from depth\n"
+    "  -h, --help           show this help\n"
+    "\n"
+    "Exit status: 0 success, 1 a failed check or an input error, 2 a usage error.\n";
+
+struct Setting {
+  std::string name;
+  std::string value;
+};
+
+struct Options {
+  std::string scene;
+  std::string camera;
+  double radius = 0.0;
+  std::string method;
+  std::vector<Setting> settings;
+  int repeat = 1;
+  bool has_max_rmse = false;
+  double max_rmse = 0.0;
+  std::string compare_to;
+  std::vector<Setting> compare_settings;
+  double margin = 0.0;
+  std::string write_ao;
+  std::string layer;
+  bool no_normals = false;
+  bool help = false;
+};
+
+const std::vector<std::string>& method_names() {
+  static const std::vector<std::string> names = {"ssao", "seed-hemisphere", "seed-sphere",
+                                                 "raymarch"};
+  return names;
+}
+
+std::string join(const std::vector<std::string>& items, const char* separator) {
+  std::string out;
+  for (size_t i = 0; i < items.size(); ++i) out += (i ? separator : "") + items[i];
+  return out;
+}
+
+double parse_double(const std::string& text, const std::string& what) {
+  errno = 0;
+  char* end = nullptr;
+  const double value = std::strtod(text.c_str(), &end);
+  if (text.empty() || end != text.c_str() + text.size() || errno == ERANGE ||
+      !std::isfinite(value)) {
+    throw UsageError(what + ": expected a finite number, got '" + text + "'");
+  }
+  return value;
+}
+
+long long parse_integer(const std::string& text, const std::string& what, long long lo,
+                        long long hi) {
+  errno = 0;
+  char* end = nullptr;
+  const long long value = std::strtoll(text.c_str(), &end, 10);
+  if (text.empty() || end != text.c_str() + text.size() || errno == ERANGE) {
+    throw UsageError(what + ": expected an integer, got '" + text + "'");
+  }
+  if (value < lo || value > hi) {
+    throw UsageError(what + ": must be in [" + std::to_string(lo) + ", " + std::to_string(hi) +
+                     "], got " + text);
+  }
+  return value;
+}
+
+Setting parse_setting(const std::string& text, const std::string& flag) {
+  const size_t eq = text.find('=');
+  if (eq == std::string::npos || eq == 0) {
+    throw UsageError(flag + " '" + text + "': expected NAME=VALUE");
+  }
+  return {text.substr(0, eq), text.substr(eq + 1)};
+}
+
+void check_method(const std::string& method, const std::string& flag) {
+  const auto& names = method_names();
+  if (std::find(names.begin(), names.end(), method) == names.end()) {
+    throw UsageError(flag + ": unknown method '" + method + "' (methods: " + join(names, ", ") +
+                     ")");
+  }
+}
+
+Options parse_args(int argc, char** argv) {
+  Options o;
+  bool has_radius = false;
+  std::vector<std::string> positional;
+  for (int i = 1; i < argc; ++i) {
+    std::string arg = argv[i];
+    if (arg == "-h" || arg == "--help") {
+      o.help = true;
+      return o;
+    }
+    if (arg == "--") {
+      for (++i; i < argc; ++i) positional.emplace_back(argv[i]);
+      break;
+    }
+    if (arg.size() < 2 || arg[0] != '-') {
+      positional.push_back(arg);
+      continue;
+    }
+    // --flag value or --flag=value.
+    std::string inline_value;
+    bool has_inline = false;
+    const size_t eq = arg.find('=');
+    if (arg.rfind("--", 0) == 0 && eq != std::string::npos) {
+      inline_value = arg.substr(eq + 1);
+      arg = arg.substr(0, eq);
+      has_inline = true;
+    }
+    auto value = [&]() -> std::string {
+      if (has_inline) return inline_value;
+      if (i + 1 >= argc) throw UsageError(arg + " needs a value");
+      return argv[++i];
+    };
+    auto no_value = [&] {
+      if (has_inline) throw UsageError(arg + " takes no value");
+    };
+    if (arg == "--camera") {
+      o.camera = value();
+    } else if (arg == "--radius") {
+      o.radius = parse_double(value(), "--radius");
+      if (!(o.radius > 0.0)) throw UsageError("--radius must be positive");
+      has_radius = true;
+    } else if (arg == "--method") {
+      o.method = value();
+      check_method(o.method, "--method");
+    } else if (arg == "--set") {
+      o.settings.push_back(parse_setting(value(), "--set"));
+    } else if (arg == "--repeat") {
+      o.repeat = static_cast<int>(parse_integer(value(), "--repeat", 1, 1000));
+    } else if (arg == "--max-rmse") {
+      o.max_rmse = parse_double(value(), "--max-rmse");
+      if (o.max_rmse < 0.0) throw UsageError("--max-rmse must not be negative");
+      o.has_max_rmse = true;
+    } else if (arg == "--compare-to") {
+      o.compare_to = value();
+      check_method(o.compare_to, "--compare-to");
+    } else if (arg == "--compare-set") {
+      o.compare_settings.push_back(parse_setting(value(), "--compare-set"));
+    } else if (arg == "--margin") {
+      o.margin = parse_double(value(), "--margin");
+      if (!(o.margin >= 0.0 && o.margin < 1.0)) throw UsageError("--margin must be in [0, 1)");
+    } else if (arg == "--write-ao") {
+      o.write_ao = value();
+    } else if (arg == "--layer") {
+      o.layer = value();
+    } else if (arg == "--no-normals") {
+      no_value();
+      o.no_normals = true;
+    } else {
+      throw UsageError("unknown option '" + arg + "'");
+    }
+  }
+  if (positional.empty()) throw UsageError("no scene EXR given");
+  if (positional.size() > 1) {
+    throw UsageError("one scene EXR expected, got " + std::to_string(positional.size()) + ": " +
+                     join(positional, " "));
+  }
+  o.scene = positional.front();
+  if (o.camera.empty()) throw UsageError("--camera CAM.json is required");
+  if (!has_radius) throw UsageError("--radius R is required");
+  if (o.method.empty()) throw UsageError("--method M is required");
+  if (o.compare_to.empty() && !o.compare_settings.empty()) {
+    throw UsageError("--compare-set needs --compare-to");
+  }
+  if (o.compare_to.empty() && o.margin != 0.0) throw UsageError("--margin needs --compare-to");
+  return o;
+}
+
+// ---------------------------------------------------------------------------------------------
+// The scene: the passes every method reads, and the ground truth.
+
+struct Scene {
+  std::string name;  // file name without folder and extension
+  std::string path;
+  int width = 0, height = 0;
+  ssao_io::Camera camera;
+  std::vector<float> depth;         // planar, 1 channel
+  std::vector<float> world_normal;  // 3 channels or empty
+  std::vector<float> truth;         // the AO pass
+  std::vector<unsigned char> mask;  // pixels that are scored
+  size_t scored = 0;
+};
+
+Scene load_scene(const Options& o) {
+  Scene s;
+  s.path = o.scene;
+  s.name = std::filesystem::path(o.scene).stem().string();
+  // The camera first: it is small and a mistake there is cheaper to find.
+  s.camera = ssao_io::read_camera_json(o.camera);
+  for (const std::string& key : s.camera.unknown_keys) {
+    std::fprintf(stderr, "%s: warning: camera file '%s': unknown key '%s' ignored\n", kProgram,
+                 o.camera.c_str(), key.c_str());
+  }
+
+  ssao_io::Image image = ssao_io::read_image(o.scene);
+  ssao_io::PassOverrides overrides;
+  overrides.layer = o.layer;
+  overrides.no_normals = o.no_normals;
+  const ssao_io::PassChannels passes =
+      ssao_io::detect_passes(image.channel_names, overrides, o.scene);
+  const std::string ao_channel = passes.layer.empty() ? "AO.R" : passes.layer + ".AO.R";
+  const int ao_index = image.find_channel(ao_channel);
+  if (ao_index < 0) {
+    throw ssao_io::Error("'" + o.scene + "' has no AO pass (no channel '" + ao_channel +
+                         "'): render it with the Ambient Occlusion pass enabled; its channels "
+                         "are: " + ssao_io::join_names(image.channel_names));
+  }
+  s.width = image.width;
+  s.height = image.height;
+  s.depth = ssao_io::extract_channels(image, {ssao_io::require_channel(image, passes.depth, o.scene)});
+  if (!passes.normal.empty()) {
+    std::vector<int> indices;
+    for (const std::string& name : passes.normal) {
+      indices.push_back(ssao_io::require_channel(image, name, o.scene));
+    }
+    s.world_normal = ssao_io::extract_channels(image, indices);
+  }
+  s.truth = ssao_io::extract_channels(image, {ao_index});
+
+  const double limit = 0.9 * s.camera.clip_end;
+  s.mask.assign(s.depth.size(), 0);
+  for (size_t p = 0; p < s.depth.size(); ++p) {
+    const float d = s.depth[p];
+    if (std::isfinite(d) && d > 0.0f && static_cast<double>(d) < limit &&
+        std::isfinite(s.truth[p])) {
+      s.mask[p] = 1;
+      ++s.scored;
+    }
+  }
+  if (s.scored == 0) {
+    throw ssao_io::Error("'" + o.scene + "' has no pixel to score (none with a finite depth in (0, " +
+                         std::to_string(limit) + "), 0.9 x the camera's clip_end)");
+  }
+  return s;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Methods. Each is prepared once (settings checked, inputs converted), then run --repeat times.
+
+std::string format_number(double value) {
+  std::ostringstream out;
+  out << value;
+  return out.str();
+}
+
+// The value of a core parameter as set by --set, typed after the parameter table.
+void set_core_param(ssao_io::Job& job, const std::vector<ssao_param_desc>& table,
+                    const Setting& s, const std::string& flag) {
+  const auto it = std::find_if(table.begin(), table.end(),
+                               [&](const ssao_param_desc& d) { return s.name == d.name; });
+  const std::string where = flag + " " + s.name + "=" + s.value;
+  if (it == table.end()) {
+    std::vector<std::string> names;
+    for (const ssao_param_desc& d : table) names.emplace_back(d.name);
+    throw UsageError(where + ": unknown parameter (parameters: " + join(names, ", ") + ")");
+  }
+  if (s.name == "radius") throw UsageError(where + ": give the radius with --radius");
+  try {
+    switch (it->type) {
+      case SSAO_PARAM_INT:
+        job.set(s.name, static_cast<int>(parse_integer(s.value, where, std::numeric_limits<int>::min(),
+                                                       std::numeric_limits<int>::max())));
+        break;
+      case SSAO_PARAM_FLOAT: job.set(s.name, parse_double(s.value, where)); break;
+      case SSAO_PARAM_STRING: job.set(s.name, s.value); break;
+      case SSAO_PARAM_FLOATS: {
+        std::vector<double> values;
+        std::stringstream list(s.value);
+        std::string item;
+        while (std::getline(list, item, ',')) values.push_back(parse_double(item, where));
+        job.set(s.name, values);
+        break;
+      }
+    }
+  } catch (const ssao_io::CoreError&) {
+    throw UsageError(where + ": " + ssao_last_error());
+  }
+}
+
+
+// The references' view of the scene: planar depth with the core's background rule (at or beyond
+// clip_end is background), view-space normals, and the core's camera model.
+ssao_ref::DepthScene reference_scene(const Scene& s) {
+  ssao_ref::DepthScene d;
+  d.width = s.width;
+  d.height = s.height;
+  ssao::CameraParams p;
+  p.orthographic = s.camera.type == "ORTHO";
+  p.lens = s.camera.lens;
+  p.sensor_width = s.camera.sensor_width;
+  p.sensor_height = s.camera.sensor_height;
+  p.sensor_fit = s.camera.sensor_fit;
+  p.shift_x = s.camera.shift_x;
+  p.shift_y = s.camera.shift_y;
+  p.ortho_scale = s.camera.ortho_scale;
+  p.pixel_aspect_x = s.camera.pixel_aspect_x;
+  p.pixel_aspect_y = s.camera.pixel_aspect_y;
+  d.camera = ssao::CameraModel(p, s.width, s.height);
+
+  d.depth = s.depth;
+  const double clip_end = s.camera.clip_end;
+  for (float& depth : d.depth) {
+    if (clip_end > 0.0 && static_cast<double>(depth) >= clip_end) {
+      depth = std::numeric_limits<float>::infinity();
+    }
+  }
+
+  if (!s.world_normal.empty()) {
+    // World to view for normals: the inverse transpose of the world-to-camera linear part, that
+    // is the transpose of camera_to_world's 3x3 (exact even if the camera is scaled).
+    const std::array<double, 16>& m = s.camera.matrix_world;  // row-major
+    d.view_normal.resize(s.world_normal.size());
+    for (size_t p3 = 0; p3 < s.world_normal.size(); p3 += 3) {
+      const double wx = s.world_normal[p3], wy = s.world_normal[p3 + 1],
+                   wz = s.world_normal[p3 + 2];
+      double v[3];
+      for (int c = 0; c < 3; ++c) v[c] = m[0 * 4 + c] * wx + m[1 * 4 + c] * wy + m[2 * 4 + c] * wz;
+      const double len = std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+      const double inv = len > 1e-20 && std::isfinite(len) ? 1.0 / len : 0.0;
+      for (int c = 0; c < 3; ++c) d.view_normal[p3 + c] = static_cast<float>(v[c] * inv);
+    }
+  }
+  return d;
+}
+
+// A method ready to run: run() writes the AO (1 channel, top row first) into *ao.
+struct Method {
+  std::string name;
+  std::string settings;  // "name=value,..." as reported
+  int threads = 1;
+  std::shared_ptr<std::vector<float>> ao = std::make_shared<std::vector<float>>();
+  std::function<void()> run;
+};
+
+// The reference methods' settings: name -> value, checked against the allowed names.
+struct ReferenceSettings {
+  int samples = 16;
+  uint32_t seed = 1;
+  ssao_ref::RayMarchSettings march;
+};
+
+ReferenceSettings parse_reference_settings(const std::string& method,
+                                           const std::vector<Setting>& settings,
+                                           const std::string& flag) {
+  ReferenceSettings r;
+  const bool march = method == "raymarch";
+  const std::vector<std::string> allowed =
+      march ? std::vector<std::string>{"rays", "steps", "thickness", "seed"}
+            : std::vector<std::string>{"samples", "seed"};
+  for (const Setting& s : settings) {
+    const std::string where = flag + " " + s.name + "=" + s.value;
+    if (std::find(allowed.begin(), allowed.end(), s.name) == allowed.end()) {
+      throw UsageError(where + ": method " + method + " has no parameter '" + s.name +
+                       "' (its parameters: " + join(allowed, ", ") + ")");
+    }
+    if (s.name == "seed") {
+      r.seed = static_cast<uint32_t>(parse_integer(s.value, where, 0, 4294967295LL));
+      r.march.seed = r.seed;
+    } else if (s.name == "samples") {
+      r.samples = static_cast<int>(parse_integer(s.value, where, 1, 4096));
+    } else if (s.name == "rays") {
+      r.march.rays = static_cast<int>(parse_integer(s.value, where, 1, 65536));
+    } else if (s.name == "steps") {
+      r.march.steps = static_cast<int>(parse_integer(s.value, where, 1, 4096));
+    } else if (s.name == "thickness") {
+      const double t = parse_double(s.value, where);
+      if (!(t > 0.0)) throw UsageError(where + ": must be positive");
+      r.march.thickness = static_cast<float>(t);
+    }
+  }
+  return r;
+}
+
+// Everything the ssao method keeps between runs.
+struct CoreState {
+  ssao_io::Job job;
+  std::vector<float> depth, normal;
+};
+
+// Prepares `name` with `settings` (from `flag`). With scene == nullptr only checks the settings
+// (so that command-line mistakes are found before any file is read).
+Method make_method(const std::string& name, const std::vector<Setting>& settings,
+                   const std::string& flag, const Scene* scene, double radius) {
+  Method m;
+  m.name = name;
+  if (name == "ssao") {
+    const std::vector<ssao_param_desc> table = ssao_io::param_table();
+    auto state = std::make_shared<CoreState>();
+    ssao_io::Job& job = state->job;
+    if (scene != nullptr) ssao_io::apply_camera(job.get(), scene->camera, scene->path);
+    try {
+      job.set("radius", radius);
+    } catch (const ssao_io::CoreError&) {
+      throw UsageError(std::string("--radius: ") + ssao_last_error());
+    }
+    // After the camera: a --set camera parameter overrides the file.
+    for (const Setting& s : settings) set_core_param(job, table, s, flag);
+    std::vector<std::string> shown = {"variant=" + job.get_string("variant"),
+                                      "samples=" + std::to_string(job.get_int("samples"))};
+    for (const Setting& s : settings) {
+      if (s.name != "variant" && s.name != "samples") shown.push_back(s.name + "=" + s.value);
+    }
+    m.settings = join(shown, ",");
+    const int requested = job.get_int("threads");
+    const unsigned hw = std::thread::hardware_concurrency();
+    m.threads = requested > 0 ? requested : (hw == 0 ? 1 : static_cast<int>(hw));
+    if (scene == nullptr) return m;
+
+    const int w = scene->width, h = scene->height;
+    state->depth = scene->depth;
+    job.set_image("depth", state->depth.data(), w, h, 1);
+    if (!scene->world_normal.empty()) {
+      state->normal = scene->world_normal;
+      job.set_image("normal", state->normal.data(), w, h, 3);
+    }
+    m.ao->assign(scene->depth.size(), 0.0f);
+    job.set_image("ao", m.ao->data(), w, h, 1);
+    m.run = [state] { state->job.run(); };
+    return m;
+  }
+
+  const ReferenceSettings r = parse_reference_settings(name, settings, flag);
+  if (name == "raymarch") {
+    m.settings = "rays=" + std::to_string(r.march.rays) + ",steps=" +
+                 std::to_string(r.march.steps) + ",thickness=" +
+                 format_number(r.march.thickness) + ",seed=" + std::to_string(r.march.seed);
+    const unsigned hw = std::thread::hardware_concurrency();
+    m.threads = std::max(1, hw == 0 ? 1 : static_cast<int>(hw));
+    if (scene != nullptr) m.threads = std::min(m.threads, scene->height);
+  } else {
+    m.settings = "samples=" + std::to_string(r.samples) + ",seed=" + std::to_string(r.seed);
+    m.threads = 1;
+  }
+  if (scene == nullptr) return m;
+
+  auto depth_scene = std::make_shared<ssao_ref::DepthScene>(reference_scene(*scene));
+  const float rad = static_cast<float>(radius);
+  auto out = m.ao;
+  if (name == "raymarch") {
+    ssao_ref::RayMarchSettings march = r.march;
+    march.radius = rad;
+    m.run = [depth_scene, march, out] { *out = ssao_ref::raymarch_ao(*depth_scene, march); };
+  } else if (name == "seed-hemisphere") {
+    m.run = [depth_scene, rad, r, out] {
+      *out = ssao_ref::seed_hemisphere_ao(*depth_scene, rad, r.samples, r.seed);
+    };
+  } else {
+    m.run = [depth_scene, rad, r, out] {
+      *out = ssao_ref::seed_sphere_ao(*depth_scene, rad, r.samples, r.seed);
+    };
+  }
+  return m;
+}
+
+// Best wall time of `repeat` runs, in milliseconds.
+double time_runs(const Method& m, int repeat) {
+  double best = std::numeric_limits<double>::infinity();
+  for (int i = 0; i < repeat; ++i) {
+    const auto start = std::chrono::steady_clock::now();
+    m.run();
+    const auto stop = std::chrono::steady_clock::now();
+    best = std::min(best, std::chrono::duration<double, std::milli>(stop - start).count());
+  }
+  return best;
+}
+
+struct Score {
+  double rmse = 0.0;
+  double mean_error = 0.0;
+};
+
+Score score(const Scene& s, const std::vector<float>& ao) {
+  if (ao.size() != s.truth.size()) {
+    throw std::logic_error("AO of " + std::to_string(ao.size()) + " pixels, expected " +
+                           std::to_string(s.truth.size()));
+  }
+  double sum = 0.0, sum_sq = 0.0;
+  for (size_t p = 0; p < ao.size(); ++p) {
+    if (!s.mask[p]) continue;
+    const double diff = static_cast<double>(ao[p]) - static_cast<double>(s.truth[p]);
+    sum += diff;
+    sum_sq += diff * diff;
+  }
+  const double n = static_cast<double>(s.scored);
+  return {std::sqrt(sum_sq / n), sum / n};
+}
+
+Score evaluate(const Scene& s, const Options& o, const Method& m) {
+  const double ms = time_runs(m, o.repeat);
+  const Score sc = score(s, *m.ao);
+  std::printf("scene=%s method=%s settings=%s normals=%s rmse=%.5f mean_error=%+.5f "
+              "time_ms=%.2f repeat=%d threads=%d pixels=%zu\n",
+              s.name.c_str(), m.name.c_str(), m.settings.c_str(),
+              s.world_normal.empty() ? "depth" : "pass", sc.rmse, sc.mean_error, ms, o.repeat,
+              m.threads, s.scored);
+  std::fflush(stdout);
+  return sc;
+}
+
+int run(const Options& o) {
+  // Command-line mistakes first, before reading anything.
+  make_method(o.method, o.settings, "--set", nullptr, o.radius);
+  if (!o.compare_to.empty()) {
+    make_method(o.compare_to, o.compare_settings, "--compare-set", nullptr, o.radius);
+  }
+
+  const Scene scene = load_scene(o);
+  int status = 0;
+  Score primary;
+  {
+    const Method m = make_method(o.method, o.settings, "--set", &scene, o.radius);
+    primary = evaluate(scene, o, m);
+    if (!o.write_ao.empty()) {
+      ssao_io::write_exr(o.write_ao, scene.width, scene.height, {"AO"}, *m.ao);
+    }
+  }
+  if (o.has_max_rmse) {
+    const bool pass = primary.rmse <= o.max_rmse;  // false for NaN
+    std::printf("check max-rmse: %s rmse %.5f %s %.5f: %s\n", o.method.c_str(), primary.rmse,
+                pass ? "<=" : ">", o.max_rmse, pass ? "PASS" : "FAIL");
+    if (!pass) status = 1;
+  }
+  if (!o.compare_to.empty()) {
+    const Method m2 = make_method(o.compare_to, o.compare_settings, "--compare-set", &scene,
+                                  o.radius);
+    const Score other = evaluate(scene, o, m2);
+    const double bound = other.rmse * (1.0 - o.margin);
+    const bool pass = primary.rmse < bound;
+    const double lower = other.rmse > 0.0 ? 100.0 * (1.0 - primary.rmse / other.rmse) : 0.0;
+    std::printf("check compare-to: %s rmse %.5f vs %s rmse %.5f: %.1f%% lower (required: more "
+                "than %.1f%%, rmse < %.5f): %s\n",
+                o.method.c_str(), primary.rmse, o.compare_to.c_str(), other.rmse, lower,
+                100.0 * o.margin, bound, pass ? "PASS" : "FAIL");
+    if (!pass) status = 1;
+  }
+  std::fflush(stdout);
+  return status;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  try {
+    const Options options = parse_args(argc, argv);
+    if (options.help) {
+      std::fputs(kUsage, stdout);
+      return 0;
+    }
+    return run(options);
+  } catch (const UsageError& e) {
+    std::fprintf(stderr, "%s: error: %s\nTry '%s --help' for more information.\n", kProgram,
+                 e.what(), kProgram);
+    return 2;
+  } catch (const std::bad_alloc&) {
+    std::fprintf(stderr, "%s: error: out of memory\n", kProgram);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "%s: error: %s\n", kProgram, e.what());
+  } catch (...) {
+    std::fprintf(stderr, "%s: error: unexpected exception\n", kProgram);
+  }
+  return 1;
+}

@@ -1,0 +1,92 @@
+#!/usr/bin/python3
+# SPDX-License-Identifier: MIT
+"""The ctypes binding (blender_addon/ssao_native.py) against the built library, without Blender.
+
+    /usr/bin/python3 tests/python/test_native.py LIBRARY
+"""
+import os
+import sys
+import unittest
+
+import numpy as np
+
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..",
+                                "blender_addon"))
+import ssao_native  # noqa: E402
+
+LIBRARY = None
+
+
+def corner_scene(width=64, height=48):
+    """Planar depth of two walls meeting at 90 degrees 6 units ahead (lens 35 mm, 36 mm)."""
+    xs = ((np.arange(width) + 0.5) / width - 0.5) * 36.0 / 35.0
+    depth = np.minimum(6.0 / (1.0 - xs), 6.0 / (1.0 + xs)).astype(np.float32)
+    return np.ascontiguousarray(np.tile(depth, (height, 1)))
+
+
+class NativeBindingTest(unittest.TestCase):
+    @classmethod
+    def setUpClass(cls):
+        cls.lib = ssao_native.load_library(LIBRARY)
+
+    def run_ao(self, depth, **params):
+        ao = np.full(depth.shape, -1.0, np.float32)
+        with ssao_native.Job(self.lib) as job:
+            job.set("lens", 35.0)
+            for key, value in params.items():
+                job.set(key, value)
+            job.set_image("depth", depth)
+            job.set_image("ao", ao)
+            job.run()
+        return ao
+
+    def test_parameter_table_has_the_documented_defaults(self):
+        params = {p["name"]: p for p in ssao_native.parameters(self.lib)}
+        self.assertEqual(params["variant"]["default_string"], "hemisphere")
+        self.assertEqual(params["radius"]["unit"], "scene units")
+        self.assertEqual(params["camera_to_world"]["count"], 16)
+
+    def test_errors_raise_with_the_library_message(self):
+        with ssao_native.Job(self.lib) as job:
+            with self.assertRaisesRegex(ssao_native.SSAOError, "unknown parameter 'radus'"):
+                job.set("radus", 1.0)
+            with self.assertRaisesRegex(ssao_native.SSAOError, "must be in"):
+                job.set("radius", -2.0)
+            with self.assertRaisesRegex(ssao_native.SSAOError, "no depth image"):
+                job.run()
+            with self.assertRaisesRegex(ssao_native.SSAOError, "float32"):
+                job.set_image("depth", np.zeros((4, 4), np.float64))
+
+    def test_corner_is_darker_at_the_crease(self):
+        depth = corner_scene()
+        ao = self.run_ao(depth, radius=1.0)
+        crease = ao[:, 31:33].mean()
+        walls = np.concatenate([ao[:, :8], ao[:, -8:]], axis=1).mean()
+        self.assertLess(crease, 0.75)
+        self.assertGreater(walls, 0.97)
+
+    def test_flipped_view_reads_in_place(self):
+        depth = corner_scene()
+        top_down = self.run_ao(depth)
+        stored_bottom_up = np.ascontiguousarray(depth[::-1])
+        view = stored_bottom_up[::-1]  # negative row stride, no copy
+        self.assertLess(view.strides[0], 0)
+        np.testing.assert_array_equal(self.run_ao(view), top_down)
+
+    def test_progress_callback_and_cancel(self):
+        depth = corner_scene()
+        seen = []
+        ao = np.zeros_like(depth)
+        with ssao_native.Job(self.lib) as job:
+            job.set_image("depth", depth)
+            job.set_image("ao", ao)
+            job.run(progress=lambda f: seen.append(f) is None)
+            self.assertEqual(seen[-1], 1.0)
+            self.assertEqual(seen, sorted(seen))
+            with self.assertRaisesRegex(ssao_native.SSAOError, "cancelled"):
+                job.run(progress=lambda f: False)
+
+
+if __name__ == "__main__":
+    LIBRARY = sys.argv.pop(1) if len(sys.argv) > 1 else None
+    unittest.main()
