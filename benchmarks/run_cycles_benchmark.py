@@ -15,6 +15,7 @@ scene in the same run (below 1 = faster). The seed ports run on one thread, libs
 march on every core unless --threads is given (it applies to libssao only).
 
     /usr/bin/python3 benchmarks/run_cycles_benchmark.py [DATA_DIR] [--repeat 3]
+        [--scenes crates,shelf] [--config variant=sphere,samples=32 ...]
 
 DATA_DIR defaults to ../shared/data relative to the repository root. Exit status: 0 success,
 1 a run of ssao_eval failed, 2 a usage error (no data folder, no scenes, no ssao_eval).
@@ -61,6 +62,10 @@ def parse_args():
                         help="time this many runs, report the fastest (default 3)")
     parser.add_argument("--threads", type=int, default=0,
                         help="threads for libssao (default 0: every core)")
+    parser.add_argument("--config", action="append", default=[],
+                        help="an extra libssao row: comma-separated NAME=VALUE core parameters, "
+                             "e.g. variant=sphere,samples=32; normals=none ignores the Normal "
+                             "pass (repeatable)")
     parser.add_argument("--eval", default=DEFAULT_EVAL,
                         help="path to ssao_eval (default: build/bin/ssao_eval)")
     args = parser.parse_args()
@@ -99,10 +104,25 @@ def find_scenes(data_dir, names):
     return scenes
 
 
+def extra_configs(texts):
+    """The --config rows: (label, method, --set arguments, samples column)."""
+    configs = []
+    for text in texts:
+        settings = [item.strip() for item in text.split(",") if item.strip()]
+        for item in settings:
+            if "=" not in item:
+                fail_usage("--config '%s': '%s' is not NAME=VALUE" % (text, item))
+        configs.append(("ssao " + ",".join(settings), "ssao", settings, None))
+    return configs
+
+
 def run_eval(args, scene, method, settings):
     command = [args.eval, scene["exr"], "--camera", scene["camera"],
                "--radius", repr(scene["radius"]), "--method", method,
                "--repeat", str(args.repeat)]
+    if "normals=none" in settings:
+        settings = [s for s in settings if s != "normals=none"]
+        command.append("--no-normals")
     if method == "ssao" and args.threads:
         settings = settings + ["threads=%d" % args.threads]
     for setting in settings:
@@ -144,6 +164,7 @@ def main():
         fail_usage("no ssao_eval at '%s': build it first (cmake --build build --target "
                    "ssao_eval) or pass --eval" % args.eval)
     scenes = find_scenes(data_dir, args.scenes)
+    configs = CONFIGS + extra_configs(args.config)
 
     header = ["scene", "method", "samples", "RMSE", "mean error", "time (ms)", "threads",
               "time / default"]
@@ -153,7 +174,7 @@ def main():
     rmse_sums = {}
     for scene in scenes:
         default_ms = None
-        for label, method, settings, fixed_samples in CONFIGS:
+        for label, method, settings, fixed_samples in configs:
             result = run_eval(args, scene, method, settings)
             ms = float(result["time_ms"])
             if default_ms is None:

@@ -27,6 +27,7 @@
 #include <sstream>
 #include <stdexcept>
 #include <string>
+#include <system_error>
 #include <thread>
 #include <vector>
 
@@ -581,6 +582,27 @@ Score evaluate(const Scene& s, const Options& o, const Method& m) {
   return sc;
 }
 
+bool same_file(const std::string& a, const std::string& b) {
+  std::error_code ec;
+  if (std::filesystem::exists(a, ec) && std::filesystem::exists(b, ec)) {
+    return std::filesystem::equivalent(a, b, ec);
+  }
+  return std::filesystem::weakly_canonical(a, ec) == std::filesystem::weakly_canonical(b, ec);
+}
+
+// --write-ao must not overwrite an input, and its folder must exist (checked before any work).
+void check_output(const Options& o) {
+  if (same_file(o.write_ao, o.scene) || same_file(o.write_ao, o.camera)) {
+    throw UsageError("--write-ao '" + o.write_ao + "' is an input file; choose another name");
+  }
+  std::filesystem::path folder = std::filesystem::path(o.write_ao).parent_path();
+  if (folder.empty()) folder = ".";
+  std::error_code ec;
+  if (!std::filesystem::is_directory(folder, ec)) {
+    throw ssao_io::Error("cannot write '" + o.write_ao + "': no folder '" + folder.string() + "'");
+  }
+}
+
 int run(const Options& o) {
   // Command-line mistakes first, before reading anything.
   make_method(o.method, o.settings, "--set", nullptr, o.radius);
@@ -588,6 +610,7 @@ int run(const Options& o) {
     make_method(o.compare_to, o.compare_settings, "--compare-set", nullptr, o.radius);
   }
 
+  if (!o.write_ao.empty()) check_output(o);
   const Scene scene = load_scene(o);
   int status = 0;
   Score primary;
@@ -611,10 +634,11 @@ int run(const Options& o) {
     const double bound = other.rmse * (1.0 - o.margin);
     const bool pass = primary.rmse < bound;
     const double lower = other.rmse > 0.0 ? 100.0 * (1.0 - primary.rmse / other.rmse) : 0.0;
-    std::printf("check compare-to: %s rmse %.5f vs %s rmse %.5f: %.1f%% lower (required: more "
-                "than %.1f%%, rmse < %.5f): %s\n",
-                o.method.c_str(), primary.rmse, o.compare_to.c_str(), other.rmse, lower,
-                100.0 * o.margin, bound, pass ? "PASS" : "FAIL");
+    std::printf("check compare-to: %s rmse %.5f vs %s rmse %.5f: %.1f%% %s (required: more "
+                "than %.1f%% lower, rmse < %.5f): %s\n",
+                o.method.c_str(), primary.rmse, o.compare_to.c_str(), other.rmse,
+                std::fabs(lower), lower >= 0.0 ? "lower" : "higher", 100.0 * o.margin, bound,
+                pass ? "PASS" : "FAIL");
     if (!pass) status = 1;
   }
   std::fflush(stdout);

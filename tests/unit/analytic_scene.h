@@ -3,6 +3,7 @@
 // (independent of the core's camera model), plus a small RAII wrapper over the C API.
 #pragma once
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <functional>
@@ -30,9 +31,10 @@ struct Plane {
   V3 point, normal;  // normal: unit, pointing into free space
 };
 
-// Solids built from planes: a "room corner" (union of two solids: concave crease) or a "ridge"
-// (intersection: convex edge), or a single plane.
-enum class Combine { single, union_concave, intersection_convex };
+// A convex solid: the intersection of the half-spaces behind its planes. A scene is the union
+// of its solids (one plane: a half-space such as a floor; two planes facing apart: a convex
+// ridge; six: a box).
+using Solid = std::vector<Plane>;
 
 struct Camera {
   bool ortho = false;
@@ -61,7 +63,31 @@ struct Scene {
   std::vector<V3> point;      // hit points (view space)
 };
 
-inline Scene ray_cast(const Camera& cam, const std::vector<Plane>& planes, Combine combine) {
+// Ray / convex solid: the ray is inside between the last plane it enters and the first it leaves.
+inline bool enter_solid(const Solid& solid, V3 o, V3 d, double& t_hit, V3& normal) {
+  double t_enter = 0.0, t_exit = std::numeric_limits<double>::infinity();
+  bool entered = false;
+  for (const Plane& pl : solid) {
+    const double denom = dot(pl.normal, d);
+    const double dist = dot(pl.normal, o - pl.point);  // > 0: origin on the free side
+    if (std::fabs(denom) < 1e-12) {
+      if (dist > 0) return false;  // parallel and outside
+      continue;
+    }
+    const double t = -dist / denom;
+    if (denom < 0) {  // entering this half-space
+      if (t > t_enter || !entered) t_enter = std::max(t_enter, t), normal = pl.normal;
+      entered = true;
+    } else {
+      t_exit = std::min(t_exit, t);
+    }
+  }
+  if (!entered || t_enter >= t_exit || t_enter <= 0) return false;
+  t_hit = t_enter;
+  return true;
+}
+
+inline Scene ray_cast(const Camera& cam, const std::vector<Solid>& solids) {
   Scene s;
   s.width = cam.width;
   s.height = cam.height;
@@ -74,33 +100,29 @@ inline Scene ray_cast(const Camera& cam, const std::vector<Plane>& planes, Combi
       V3 o, d;
       cam.ray(x, y, o, d);
       double best_t = std::numeric_limits<double>::infinity();
-      int best = -1;
-      for (size_t i = 0; i < planes.size(); ++i) {
-        const double denom = dot(planes[i].normal, d);
-        if (std::fabs(denom) < 1e-12) continue;
-        const double t = dot(planes[i].normal, planes[i].point - o) / denom;
-        if (t <= 0) continue;
-        const bool better = combine == Combine::intersection_convex ? (best < 0 || t > best_t)
-                                                                    : t < best_t;
-        if (better) best_t = t, best = int(i);
+      V3 best_normal{0, 0, 0};
+      for (const Solid& solid : solids) {
+        double t = 0;
+        V3 normal{0, 0, 0};
+        if (enter_solid(solid, o, d, t, normal) && t < best_t) best_t = t, best_normal = normal;
       }
-      if (best < 0) continue;
+      if (!std::isfinite(best_t)) continue;
       const V3 p = o + d * best_t;
-      // For a convex ridge the hit must lie inside the other half-spaces too.
-      if (combine == Combine::intersection_convex) {
-        bool inside = true;
-        for (const Plane& pl : planes) inside = inside && dot(pl.normal, p - pl.point) < 1e-9;
-        if (!inside) continue;
-      }
       const size_t i = size_t(y) * cam.width + x;
       s.depth[i] = float(-p.z);
       s.point[i] = p;
-      s.normal[3 * i + 0] = float(planes[best].normal.x);
-      s.normal[3 * i + 1] = float(planes[best].normal.y);
-      s.normal[3 * i + 2] = float(planes[best].normal.z);
+      s.normal[3 * i + 0] = float(best_normal.x);
+      s.normal[3 * i + 1] = float(best_normal.y);
+      s.normal[3 * i + 2] = float(best_normal.z);
     }
   }
   return s;
+}
+
+// An axis-aligned box [lo, hi] as a solid.
+inline Solid box(V3 lo, V3 hi) {
+  return {{lo, {-1, 0, 0}}, {lo, {0, -1, 0}}, {lo, {0, 0, -1}},
+          {hi, {1, 0, 0}},  {hi, {0, 1, 0}},  {hi, {0, 0, 1}}};
 }
 
 // Cosine-weighted visibility within distance r of a point on a plane at distance x from a

@@ -37,21 +37,20 @@ Stats stats_over(const Scene& s, const std::vector<float>& ao,
 const auto everywhere = [](int, int) { return true; };
 
 Scene facing_plane(const Camera& cam) {
-  return ray_cast(cam, {{{0, 0, -5}, {0, 0, 1}}}, Combine::single);
+  return ray_cast(cam, {{{{0, 0, -5}, {0, 0, 1}}}});
 }
 
 Scene tilted_plane(const Camera& cam) {
   // 60 degrees from facing the camera, rising away from it.
   const double a = 60.0 * M_PI / 180.0;
-  return ray_cast(cam, {{{0, 0, -5}, {0, std::sin(a), std::cos(a)}}}, Combine::single);
+  return ray_cast(cam, {{{{0, 0, -5}, {0, std::sin(a), std::cos(a)}}}});
 }
 
 // Two walls meeting at 90 degrees along the vertical line x = 0, z = -6, opening to the camera.
 const V3 kCrease{0, 0, -6};
 Scene concave_corner(const Camera& cam) {
-  return ray_cast(cam,
-                  {{kCrease, normalized({1, 0, 1})}, {kCrease, normalized({-1, 0, 1})}},
-                  Combine::union_concave);
+  // The union of the two half-spaces behind the walls.
+  return ray_cast(cam, {{{kCrease, normalized({1, 0, 1})}}, {{kCrease, normalized({-1, 0, 1})}}});
 }
 
 double distance_to_crease(const Scene& s, int x, int y) {
@@ -179,8 +178,8 @@ TEST(Analytic, SphereDarkensTheCornerToHalfAtTheCrease) {
 TEST(Analytic, ConvexRidgeIsNotDarkenedByHemisphere) {
   const Camera cam = perspective();
   const V3 ridge{0, 0, -5};
-  Scene s = ray_cast(cam, {{ridge, normalized({1, 0, 1})}, {ridge, normalized({-1, 0, 1})}},
-                     Combine::intersection_convex);
+  // One solid: the intersection of the half-spaces behind both faces.
+  Scene s = ray_cast(cam, {{{ridge, normalized({1, 0, 1})}, {ridge, normalized({-1, 0, 1})}}});
   for (bool normals : {true, false}) {
     const auto ao = compute_ao(s, cam, 1.0, "hemisphere", normals);
     // Pixels on the ridge itself have a reconstructed normal that straddles both faces.

@@ -16,9 +16,8 @@ namespace {
 
 // A floor with a wall behind it, seen from above at an angle: enough occlusion to compare runs.
 Scene floor_and_wall(const Camera& cam) {
-  return ray_cast(cam,
-                  {{{0, -1, -6}, normalized({0, 1, 0.0})}, {{0, 0, -8}, normalized({0, 0.2, 1})}},
-                  Combine::union_concave);
+  return ray_cast(cam, {{{{0, -1, -6}, normalized({0, 1, 0.0})}},
+                        {{{0, 0, -8}, normalized({0, 0.2, 1})}}});
 }
 
 bool contains(const char* haystack, const char* needle) {
