@@ -167,14 +167,16 @@ void Job::run() {
   const int samples = v.get_int("samples");
   const Kernel kernel = sphere ? make_sphere_kernel(samples) : make_hemisphere_kernel(samples);
 
+  const VisibilityEstimator estimate = sphere ? sphere_visibility : hemisphere_visibility;
+
   progress.set_stage(0.1, 0.9);
   std::vector<float> visibility(size_t(width) * size_t(height), 1.0f);
   parallel_rows(height, threads, progress, [&](int y) {
     float* row = visibility.data() + size_t(y) * width;
-    if (sphere) {
-      sphere_row(gbuffer, kernel, settings, y, row);
-    } else {
-      hemisphere_row(gbuffer, kernel, settings, y, row);
+    for (int x = 0; x < width; ++x) {
+      if (is_receiver(gbuffer, x, y, settings.radius)) {
+        row[x] = estimate(gbuffer, kernel, settings, x, y);
+      }
     }
   });
 

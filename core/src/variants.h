@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: MIT
-// The AO variants. Each computes raw visibility (1 = unoccluded) for one row of pixels; the job
-// runs them over the image, then denoises and shapes the result.
+// The AO variants. Each estimates the raw visibility (1 = unoccluded) of one receiver pixel; the
+// job runs them over the image, then denoises and shapes the result.
 #pragma once
 
 #include <cmath>
@@ -21,17 +21,21 @@ struct VariantSettings {
   bool sphere_normalized = true;
 };
 
-void hemisphere_row(const GBuffer& g, const Kernel& kernel, const VariantSettings& s, int y,
-                    float* visibility);
-void sphere_row(const GBuffer& g, const Kernel& kernel, const VariantSettings& s, int y,
-                float* visibility);
+// Estimators for pixel (x, y), which must be a receiver (below).
+using VisibilityEstimator = float (*)(const GBuffer& g, const Kernel& kernel,
+                                      const VariantSettings& s, int x, int y);
+float hemisphere_visibility(const GBuffer& g, const Kernel& kernel, const VariantSettings& s,
+                            int x, int y);
+float sphere_visibility(const GBuffer& g, const Kernel& kernel, const VariantSettings& s, int x,
+                        int y);
+
+// Pixels worth estimating: geometry whose kernel covers at least half a pixel (a smaller one
+// sees no other pixel). Every other pixel has visibility 1 without any work.
+inline bool is_receiver(const GBuffer& g, int x, int y, float radius) {
+  return g.is_geometry(x, y) && radius >= 0.5f * g.camera().pixel_footprint(g.depth(x, y));
+}
 
 // --- helpers shared by the variants ---
-
-// Kernels whose radius covers less than half a pixel see no other pixel: skip them (AO = 1).
-inline bool radius_is_subpixel(const GBuffer& g, float planar_depth, float radius) {
-  return radius < 0.5f * g.camera().pixel_footprint(planar_depth);
-}
 
 // Looks up the surface seen through the pixel that view-space point s projects to. Returns false
 // when s falls outside the image (or behind a perspective camera): such a sample tells nothing.
