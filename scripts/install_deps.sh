@@ -4,7 +4,7 @@
 set -euo pipefail
 
 PACKAGES=(
-  g++ cmake ninja-build pkg-config          # build
+  g++ cmake ninja-build pkg-config clang-format   # build, style check
   libgtest-dev                              # unit tests
   libopenimageio-dev openimageio-tools      # EXR I/O of the command-line tool
   libopenexr-dev nlohmann-json3-dev

@@ -88,10 +88,18 @@ void apply_command_line_params(ssao_io::Job& job, const std::vector<ParamSetting
   for (const ParamSetting& setting : params) {
     try {
       switch (setting.type) {
-        case SSAO_PARAM_INT: job.set(setting.name, setting.int_value); break;
-        case SSAO_PARAM_FLOAT: job.set(setting.name, setting.float_value); break;
-        case SSAO_PARAM_STRING: job.set(setting.name, setting.string_value); break;
-        case SSAO_PARAM_FLOATS: job.set(setting.name, setting.float_values); break;
+        case SSAO_PARAM_INT:
+          job.set(setting.name, setting.int_value);
+          break;
+        case SSAO_PARAM_FLOAT:
+          job.set(setting.name, setting.float_value);
+          break;
+        case SSAO_PARAM_STRING:
+          job.set(setting.name, setting.string_value);
+          break;
+        case SSAO_PARAM_FLOATS:
+          job.set(setting.name, setting.float_values);
+          break;
       }
     } catch (const ssao_io::CoreError&) {
       throw UsageError(setting.flag + " " + setting.text + ": " + ssao_last_error());
@@ -172,8 +180,8 @@ double compute_ao(ssao_io::Job& job, bool quiet) {
 
 // The output file's channels: beauty's (named R, G, B[, A]) x AO then AO, or AO alone.
 void write_output(const Options& options, const Inputs& in, const Outputs& out) {
-  const auto write = ssao_io::is_preview_path(options.output) ? ssao_io::write_preview
-                                                               : ssao_io::write_exr;
+  const auto write =
+      ssao_io::is_preview_path(options.output) ? ssao_io::write_preview : ssao_io::write_exr;
   const size_t pixels = in.image.pixel_count();
   if (out.composite.empty()) {
     write(options.output, in.image.width, in.image.height, {"AO"}, out.ao);

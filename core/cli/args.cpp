@@ -140,8 +140,12 @@ ParamSetting parse_param(const ssao_param_desc& desc, const std::string& flag,
   setting.text = text;
   setting.type = desc.type;
   switch (desc.type) {
-    case SSAO_PARAM_INT: setting.int_value = parse_int(flag, text); break;
-    case SSAO_PARAM_FLOAT: setting.float_value = parse_float(flag, text); break;
+    case SSAO_PARAM_INT:
+      setting.int_value = parse_int(flag, text);
+      break;
+    case SSAO_PARAM_FLOAT:
+      setting.float_value = parse_float(flag, text);
+      break;
     case SSAO_PARAM_STRING: {
       const std::vector<std::string> choices = split(desc.choices ? desc.choices : "", '|');
       if (std::find(choices.begin(), choices.end(), text) == choices.end()) {
@@ -256,10 +260,14 @@ std::string help_entry(const std::string& left, const std::string& text) {
 
 std::string param_metavar(const ssao_param_desc& desc) {
   switch (desc.type) {
-    case SSAO_PARAM_INT: return "N";
-    case SSAO_PARAM_FLOAT: return "X";
-    case SSAO_PARAM_STRING: return desc.choices ? desc.choices : "S";
-    case SSAO_PARAM_FLOATS: return "X1,...,X" + std::to_string(desc.count);
+    case SSAO_PARAM_INT:
+      return "N";
+    case SSAO_PARAM_FLOAT:
+      return "X";
+    case SSAO_PARAM_STRING:
+      return desc.choices ? desc.choices : "S";
+    case SSAO_PARAM_FLOATS:
+      return "X1,...,X" + std::to_string(desc.count);
   }
   return "VALUE";
 }

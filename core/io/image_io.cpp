@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: MIT
 #include "io/image_io.h"
 
-
+#include <OpenImageIO/imageio.h>
 #include <fcntl.h>
 #include <sys/stat.h>
 #include <unistd.h>
@@ -18,8 +18,6 @@
 #include <memory>
 #include <new>
 #include <system_error>
-
-#include <OpenImageIO/imageio.h>
 
 namespace fs = std::filesystem;
 

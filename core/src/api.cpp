@@ -48,12 +48,18 @@ SSAO_API int ssao_version(void) { return SSAO_VERSION; }
 
 SSAO_API const char* ssao_status_string(ssao_status status) {
   switch (status) {
-    case SSAO_OK: return "success";
-    case SSAO_ERROR_INVALID_ARGUMENT: return "invalid argument";
-    case SSAO_ERROR_INVALID_OPERATION: return "invalid operation";
-    case SSAO_ERROR_OUT_OF_MEMORY: return "out of memory";
-    case SSAO_ERROR_CANCELLED: return "cancelled";
-    case SSAO_ERROR_INTERNAL: return "internal error";
+    case SSAO_OK:
+      return "success";
+    case SSAO_ERROR_INVALID_ARGUMENT:
+      return "invalid argument";
+    case SSAO_ERROR_INVALID_OPERATION:
+      return "invalid operation";
+    case SSAO_ERROR_OUT_OF_MEMORY:
+      return "out of memory";
+    case SSAO_ERROR_CANCELLED:
+      return "cancelled";
+    case SSAO_ERROR_INTERNAL:
+      return "internal error";
   }
   return "unknown status";
 }

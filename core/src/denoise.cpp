@@ -45,8 +45,8 @@ float bilateral_pixel(const GBuffer& g, const std::vector<float>& in, float radi
       const float plane_distance = std::fabs(dot(g.position(sx, sy) - p, n)) / plane_scale;
       const float normal_agreement = std::max(0.0f, dot(g.normal(sx, sy), n));
       const float n2 = normal_agreement * normal_agreement;
-      const float w = tap[dx + 2] * tap[dy + 2] * n2 * n2 /
-                      (1.0f + plane_distance * plane_distance);
+      const float w =
+          tap[dx + 2] * tap[dy + 2] * n2 * n2 / (1.0f + plane_distance * plane_distance);
       sum += w * in[size_t(sy) * g.width() + sx];
       weight_sum += w;
     }
@@ -56,8 +56,8 @@ float bilateral_pixel(const GBuffer& g, const std::vector<float>& in, float radi
 
 }  // namespace
 
-std::vector<float> denoise(const GBuffer& g, const std::vector<float>& visibility,
-                           DenoiseMode mode, float radius, int threads, Progress& progress) {
+std::vector<float> denoise(const GBuffer& g, const std::vector<float>& visibility, DenoiseMode mode,
+                           float radius, int threads, Progress& progress) {
   if (mode == DenoiseMode::none) return visibility;
   std::vector<float> out(visibility.size());
   parallel_rows(g.height(), threads, progress, [&](int y) {

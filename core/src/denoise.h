@@ -12,7 +12,7 @@ namespace ssao {
 enum class DenoiseMode { none, box4, bilateral };
 
 // Returns the filtered visibility; background pixels keep their value and are never read.
-std::vector<float> denoise(const GBuffer& g, const std::vector<float>& visibility,
-                           DenoiseMode mode, float radius, int threads, Progress& progress);
+std::vector<float> denoise(const GBuffer& g, const std::vector<float>& visibility, DenoiseMode mode,
+                           float radius, int threads, Progress& progress);
 
 }  // namespace ssao

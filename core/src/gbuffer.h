@@ -14,7 +14,7 @@ namespace ssao {
 
 struct GBufferInputs {
   ImageView depth;
-  ImageView normal;       // optional (data == nullptr: reconstruct from depth)
+  ImageView normal;  // optional (data == nullptr: reconstruct from depth)
   bool radial_depth = false;
   bool world_normals = true;
   double camera_to_world[16] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};

@@ -181,15 +181,14 @@ void Job::run() {
   });
 
   progress.set_stage(0.9, 1.0);
-  visibility = denoise(gbuffer, visibility, denoise_mode(v.get_string("denoise")),
-                       settings.radius, threads, progress);
+  visibility = denoise(gbuffer, visibility, denoise_mode(v.get_string("denoise")), settings.radius,
+                       threads, progress);
 
   // Outputs are written only now, after every stage succeeded: a failed or cancelled run leaves
   // the caller's buffers untouched.
-  const Shaping shaping{static_cast<float>(v.get_float("power")),
-                        static_cast<float>(v.get_float("strength")),
-                        static_cast<float>(v.get_float("remap_min")),
-                        static_cast<float>(v.get_float("remap_max"))};
+  const Shaping shaping{
+      static_cast<float>(v.get_float("power")), static_cast<float>(v.get_float("strength")),
+      static_cast<float>(v.get_float("remap_min")), static_cast<float>(v.get_float("remap_max"))};
   for (int y = 0; y < height; ++y) {
     for (int x = 0; x < width; ++x) {
       const size_t i = size_t(y) * width + x;

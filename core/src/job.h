@@ -6,8 +6,8 @@
 #include <string>
 
 #include "image_view.h"
-#include "params.h"
 #include "parallel.h"
+#include "params.h"
 
 namespace ssao {
 

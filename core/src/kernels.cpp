@@ -38,8 +38,7 @@ Kernel make_hemisphere_kernel(int samples) {
     const float disk_radius = std::sqrt((float(k) + 0.5f) / float(samples));
     const float angle = float(k) * kGoldenAngle;
     const float z = std::sqrt(std::max(0.0f, 1.0f - disk_radius * disk_radius));
-    kernel.directions.push_back(
-        {disk_radius * std::cos(angle), disk_radius * std::sin(angle), z});
+    kernel.directions.push_back({disk_radius * std::cos(angle), disk_radius * std::sin(angle), z});
     kernel.stratum.push_back(int((long(k) * step) % samples));
   }
   return kernel;

@@ -14,8 +14,8 @@ constexpr double kInf = HUGE_VAL;
 
 ssao_param_desc int_param(const char* name, int def, int lo, int hi, const char* unit,
                           const char* description) {
-  return {name, SSAO_PARAM_INT, double(def), double(lo), double(hi), nullptr, nullptr, 1, unit,
-          description};
+  return {name,    SSAO_PARAM_INT, double(def), double(lo), double(hi),
+          nullptr, nullptr,        1,           unit,       description};
 }
 ssao_param_desc float_param(const char* name, double def, double lo, double hi, const char* unit,
                             const char* description) {
@@ -48,9 +48,10 @@ const std::vector<ssao_param_desc>& table() {
                   "samples sit at radius * lerp(0.1, 1, s^p) for s uniform in [0,1): 0 puts all "
                   "on the kernel's surface, 2 clusters them toward the centre as the seed code "
                   "does"),
-      float_param("thickness", 0.5, 0.01, 100.0, "fraction of radius",
-                  "hemisphere: assumed thickness of surfaces: a sample this far behind the visible surface "
-                  "counts fully, fading out at twice the distance (range check against halos)"),
+      float_param(
+          "thickness", 0.5, 0.01, 100.0, "fraction of radius",
+          "hemisphere: assumed thickness of surfaces: a sample this far behind the visible surface "
+          "counts fully, fading out at twice the distance (range check against halos)"),
       string_param("sphere_mode", "normalized", "normalized|classic",
                    "sphere variant: classic reads about 0.5 on a flat wall; normalized maps an "
                    "unoccluded flat surface to 1"),
@@ -114,10 +115,14 @@ bool is_choice(const ssao_param_desc& d, const char* value) {
 
 const char* type_name(ssao_param_type type) {
   switch (type) {
-    case SSAO_PARAM_INT: return "an integer";
-    case SSAO_PARAM_FLOAT: return "a float";
-    case SSAO_PARAM_STRING: return "a string";
-    case SSAO_PARAM_FLOATS: return "a float array";
+    case SSAO_PARAM_INT:
+      return "an integer";
+    case SSAO_PARAM_FLOAT:
+      return "a float";
+    case SSAO_PARAM_STRING:
+      return "a string";
+    case SSAO_PARAM_FLOATS:
+      return "a float array";
   }
   return "unknown";
 }

@@ -8,8 +8,8 @@
 
 namespace ssao {
 
-float hemisphere_visibility(const GBuffer& g, const Kernel& kernel, const VariantSettings& s,
-                            int x, int y) {
+float hemisphere_visibility(const GBuffer& g, const Kernel& kernel, const VariantSettings& s, int x,
+                            int y) {
   const int n = int(kernel.directions.size());
   const Vec3 p = g.position(x, y);
   const Vec3 normal = g.normal(x, y);

@@ -24,8 +24,8 @@ struct VariantSettings {
 // Estimators for pixel (x, y), which must be a receiver (below).
 using VisibilityEstimator = float (*)(const GBuffer& g, const Kernel& kernel,
                                       const VariantSettings& s, int x, int y);
-float hemisphere_visibility(const GBuffer& g, const Kernel& kernel, const VariantSettings& s,
-                            int x, int y);
+float hemisphere_visibility(const GBuffer& g, const Kernel& kernel, const VariantSettings& s, int x,
+                            int y);
 float sphere_visibility(const GBuffer& g, const Kernel& kernel, const VariantSettings& s, int x,
                         int y);
 

@@ -2,10 +2,9 @@
  * The smallest use of libssao from C: AO of a 90-degree corner seen by a 35 mm camera.
  * Built and run by the tests (it also proves the header is valid C). */
 #include <math.h>
+#include <ssao/ssao.h>
 #include <stdio.h>
 #include <stdlib.h>
-
-#include <ssao/ssao.h>
 
 enum { WIDTH = 64, HEIGHT = 48 };
 

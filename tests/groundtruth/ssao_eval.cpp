@@ -12,8 +12,8 @@
 // unreadable input, 2 a command-line mistake.
 #include <algorithm>
 #include <array>
-#include <chrono>
 #include <cerrno>
+#include <chrono>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
@@ -288,11 +288,13 @@ Scene load_scene(const Options& o) {
   if (ao_index < 0) {
     throw ssao_io::Error("'" + o.scene + "' has no AO pass (no channel '" + ao_channel +
                          "'): render it with the Ambient Occlusion pass enabled; its channels "
-                         "are: " + ssao_io::join_names(image.channel_names));
+                         "are: " +
+                         ssao_io::join_names(image.channel_names));
   }
   s.width = image.width;
   s.height = image.height;
-  s.depth = ssao_io::extract_channels(image, {ssao_io::require_channel(image, passes.depth, o.scene)});
+  s.depth =
+      ssao_io::extract_channels(image, {ssao_io::require_channel(image, passes.depth, o.scene)});
   if (!passes.normal.empty()) {
     std::vector<int> indices;
     for (const std::string& name : passes.normal) {
@@ -313,7 +315,8 @@ Scene load_scene(const Options& o) {
     }
   }
   if (s.scored == 0) {
-    throw ssao_io::Error("'" + o.scene + "' has no pixel to score (none with a finite depth in (0, " +
+    throw ssao_io::Error("'" + o.scene +
+                         "' has no pixel to score (none with a finite depth in (0, " +
                          std::to_string(limit) + "), 0.9 x the camera's clip_end)");
   }
   return s;
@@ -329,8 +332,8 @@ std::string format_number(double value) {
 }
 
 // The value of a core parameter as set by --set, typed after the parameter table.
-void set_core_param(ssao_io::Job& job, const std::vector<ssao_param_desc>& table,
-                    const Setting& s, const std::string& flag) {
+void set_core_param(ssao_io::Job& job, const std::vector<ssao_param_desc>& table, const Setting& s,
+                    const std::string& flag) {
   const auto it = std::find_if(table.begin(), table.end(),
                                [&](const ssao_param_desc& d) { return s.name == d.name; });
   const std::string where = flag + " " + s.name + "=" + s.value;
@@ -343,11 +346,16 @@ void set_core_param(ssao_io::Job& job, const std::vector<ssao_param_desc>& table
   try {
     switch (it->type) {
       case SSAO_PARAM_INT:
-        job.set(s.name, static_cast<int>(parse_integer(s.value, where, std::numeric_limits<int>::min(),
-                                                       std::numeric_limits<int>::max())));
+        job.set(s.name,
+                static_cast<int>(parse_integer(s.value, where, std::numeric_limits<int>::min(),
+                                               std::numeric_limits<int>::max())));
         break;
-      case SSAO_PARAM_FLOAT: job.set(s.name, parse_double(s.value, where)); break;
-      case SSAO_PARAM_STRING: job.set(s.name, s.value); break;
+      case SSAO_PARAM_FLOAT:
+        job.set(s.name, parse_double(s.value, where));
+        break;
+      case SSAO_PARAM_STRING:
+        job.set(s.name, s.value);
+        break;
       case SSAO_PARAM_FLOATS: {
         std::vector<double> values;
         std::stringstream list(s.value);
@@ -361,7 +369,6 @@ void set_core_param(ssao_io::Job& job, const std::vector<ssao_param_desc>& table
     throw UsageError(where + ": " + ssao_last_error());
   }
 }
-
 
 // The references' view of the scene: planar depth with the core's background rule (at or beyond
 // clip_end is background), view-space normals, and the core's camera model.
@@ -506,9 +513,9 @@ Method make_method(const std::string& name, const std::vector<Setting>& settings
 
   const ReferenceSettings r = parse_reference_settings(name, settings, flag);
   if (name == "raymarch") {
-    m.settings = "rays=" + std::to_string(r.march.rays) + ",steps=" +
-                 std::to_string(r.march.steps) + ",thickness=" +
-                 format_number(r.march.thickness) + ",seed=" + std::to_string(r.march.seed);
+    m.settings =
+        "rays=" + std::to_string(r.march.rays) + ",steps=" + std::to_string(r.march.steps) +
+        ",thickness=" + format_number(r.march.thickness) + ",seed=" + std::to_string(r.march.seed);
     const unsigned hw = std::thread::hardware_concurrency();
     m.threads = std::max(1, hw == 0 ? 1 : static_cast<int>(hw));
     if (scene != nullptr) m.threads = std::min(m.threads, scene->height);
@@ -573,11 +580,11 @@ Score score(const Scene& s, const std::vector<float>& ao) {
 Score evaluate(const Scene& s, const Options& o, const Method& m) {
   const double ms = time_runs(m, o.repeat);
   const Score sc = score(s, *m.ao);
-  std::printf("scene=%s method=%s settings=%s normals=%s rmse=%.5f mean_error=%+.5f "
-              "time_ms=%.2f repeat=%d threads=%d pixels=%zu\n",
-              s.name.c_str(), m.name.c_str(), m.settings.c_str(),
-              s.world_normal.empty() ? "depth" : "pass", sc.rmse, sc.mean_error, ms, o.repeat,
-              m.threads, s.scored);
+  std::printf(
+      "scene=%s method=%s settings=%s normals=%s rmse=%.5f mean_error=%+.5f "
+      "time_ms=%.2f repeat=%d threads=%d pixels=%zu\n",
+      s.name.c_str(), m.name.c_str(), m.settings.c_str(), s.world_normal.empty() ? "depth" : "pass",
+      sc.rmse, sc.mean_error, ms, o.repeat, m.threads, s.scored);
   std::fflush(stdout);
   return sc;
 }
@@ -628,17 +635,17 @@ int run(const Options& o) {
     if (!pass) status = 1;
   }
   if (!o.compare_to.empty()) {
-    const Method m2 = make_method(o.compare_to, o.compare_settings, "--compare-set", &scene,
-                                  o.radius);
+    const Method m2 =
+        make_method(o.compare_to, o.compare_settings, "--compare-set", &scene, o.radius);
     const Score other = evaluate(scene, o, m2);
     const double bound = other.rmse * (1.0 - o.margin);
     const bool pass = primary.rmse < bound;
     const double lower = other.rmse > 0.0 ? 100.0 * (1.0 - primary.rmse / other.rmse) : 0.0;
-    std::printf("check compare-to: %s rmse %.5f vs %s rmse %.5f: %.1f%% %s (required: more "
-                "than %.1f%% lower, rmse < %.5f): %s\n",
-                o.method.c_str(), primary.rmse, o.compare_to.c_str(), other.rmse,
-                std::fabs(lower), lower >= 0.0 ? "lower" : "higher", 100.0 * o.margin, bound,
-                pass ? "PASS" : "FAIL");
+    std::printf(
+        "check compare-to: %s rmse %.5f vs %s rmse %.5f: %.1f%% %s (required: more "
+        "than %.1f%% lower, rmse < %.5f): %s\n",
+        o.method.c_str(), primary.rmse, o.compare_to.c_str(), other.rmse, std::fabs(lower),
+        lower >= 0.0 ? "lower" : "higher", 100.0 * o.margin, bound, pass ? "PASS" : "FAIL");
     if (!pass) status = 1;
   }
   std::fflush(stdout);

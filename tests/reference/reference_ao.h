@@ -14,16 +14,17 @@ namespace ssao_ref {
 
 struct DepthScene {
   int width = 0, height = 0;
-  std::vector<float> depth;        // planar depth, row 0 = top; background = +inf or >= 1e9
-  std::vector<float> view_normal;  // 3 floats per pixel, view space (-Z forward), unit; may be empty
+  std::vector<float> depth;  // planar depth, row 0 = top; background = +inf or >= 1e9
+  std::vector<float>
+      view_normal;  // 3 floats per pixel, view space (-Z forward), unit; may be empty
   ssao::CameraModel camera{ssao::CameraParams{}, 1, 1};
 };
 
 struct RayMarchSettings {
-  float radius = 1.0f;        // scene units (Cycles' AO distance)
-  int rays = 128;             // cosine-weighted rays per pixel
-  int steps = 24;             // steps along each ray
-  float thickness = 0.5f;     // occluders are assumed this many radii thick
+  float radius = 1.0f;     // scene units (Cycles' AO distance)
+  int rays = 128;          // cosine-weighted rays per pixel
+  int steps = 24;          // steps along each ray
+  float thickness = 0.5f;  // occluders are assumed this many radii thick
   uint32_t seed = 1;
 };
 

@@ -149,8 +149,8 @@ inline ssao::Vec3 pixel_normal(const DepthScene& s, int x, int y, bool orient_to
   const size_t i = 3 * index(s, x, y);
   const ssao::Vec3 p = pixel_position(s, x, y);
   const ssao::Vec3 towards = s.camera.towards_camera(p);
-  ssao::Vec3 n = ssao::normalize_or({s.view_normal[i], s.view_normal[i + 1], s.view_normal[i + 2]},
-                                    towards);
+  ssao::Vec3 n =
+      ssao::normalize_or({s.view_normal[i], s.view_normal[i + 1], s.view_normal[i + 2]}, towards);
   if (orient_to_camera && ssao::dot(n, towards) < 0.0f) n = -n;
   return n;
 }

@@ -134,8 +134,7 @@ std::vector<float> seed_sphere_ao(const DepthScene& scene, float radius, int sam
       int occluded = 0;
       for (int i = 0; i < samples; ++i) {
         const int pass = i / 8;
-        const Vec3 r =
-            noise[static_cast<size_t>(pass * kNoise * kNoise + noise_index(x, y))];
+        const Vec3 r = noise[static_cast<size_t>(pass * kNoise * kNoise + noise_index(x, y))];
         const Vec3 k = kernel[i % 8];
         const Vec3 reflected = k - r * (2.0f * ssao::dot(k, r));  // HLSL reflect(k, r)
         // Our depth is linear in scene units, so the kernel is scaled in view space rather

@@ -3,6 +3,8 @@
 // (independent of the core's camera model), plus a small RAII wrapper over the C API.
 #pragma once
 
+#include <gtest/gtest.h>
+
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -10,8 +12,6 @@
 #include <limits>
 #include <string>
 #include <vector>
-
-#include <gtest/gtest.h>
 
 #include "ssao/ssao.h"
 
@@ -44,8 +44,8 @@ struct Camera {
 
   // Ray through the centre of pixel (x, y), y = 0 on top, in view space (-Z forward).
   void ray(int x, int y, V3& origin, V3& direction) const {
-    const double nx = (x + 0.5) / width - 0.5;                          // -0.5 .. 0.5
-    const double ny = (0.5 - (y + 0.5) / height) * height / width;     // same units as nx
+    const double nx = (x + 0.5) / width - 0.5;                      // -0.5 .. 0.5
+    const double ny = (0.5 - (y + 0.5) / height) * height / width;  // same units as nx
     if (ortho) {
       origin = {nx * ortho_scale, ny * ortho_scale, 0.0};
       direction = {0.0, 0.0, -1.0};

@@ -36,9 +36,7 @@ Stats stats_over(const Scene& s, const std::vector<float>& ao,
 
 const auto everywhere = [](int, int) { return true; };
 
-Scene facing_plane(const Camera& cam) {
-  return ray_cast(cam, {{{{0, 0, -5}, {0, 0, 1}}}});
-}
+Scene facing_plane(const Camera& cam) { return ray_cast(cam, {{{{0, 0, -5}, {0, 0, 1}}}}); }
 
 Scene tilted_plane(const Camera& cam) {
   // 60 degrees from facing the camera, rising away from it.
@@ -98,8 +96,8 @@ TEST(Analytic, TiltedPlaneIsUnoccluded) {
 TEST(Analytic, ClassicSphereReadsHalfOnAFlatWall) {
   const Camera cam = perspective();
   Scene s = facing_plane(cam);
-  const auto ao = compute_ao(s, cam, 0.5, "sphere", false,
-                             [](Job& j) { j.set("sphere_mode", "classic"); });
+  const auto ao =
+      compute_ao(s, cam, 0.5, "sphere", false, [](Job& j) { j.set("sphere_mode", "classic"); });
   // Pixels whose kernel stays inside the image (the radius covers about 9 pixels here); the
   // default bias drops the pair nearest the surface: 16 samples read 0.5625 (measured).
   const Stats st = stats_over(s, ao, [&](int x, int y) {
@@ -135,12 +133,10 @@ void expect_corner_matches_closed_form(const Camera& cam, const char* label) {
   EXPECT_LT(rmse, 0.05) << label;
   EXPECT_LT(worst, 0.2) << label;
 
-  const Stats crease = stats_over(s, ao, [&](int x, int y) {
-    return distance_to_crease(s, x, y) < 0.2 * radius;
-  });
-  const Stats walls = stats_over(s, ao, [&](int x, int y) {
-    return distance_to_crease(s, x, y) > 1.2 * radius;
-  });
+  const Stats crease =
+      stats_over(s, ao, [&](int x, int y) { return distance_to_crease(s, x, y) < 0.2 * radius; });
+  const Stats walls =
+      stats_over(s, ao, [&](int x, int y) { return distance_to_crease(s, x, y) > 1.2 * radius; });
   EXPECT_LT(crease.mean, walls.mean - 0.3) << label;
   EXPECT_GE(walls.min, 0.95) << label;
 }
@@ -163,12 +159,10 @@ TEST(Analytic, SphereDarkensTheCornerToHalfAtTheCrease) {
   });
   // At the crease three quarters of the sphere are inside the walls: visibility 1/4, which the
   // normalized mode maps to 1/2.
-  const Stats crease = stats_over(s, ao, [&](int x, int y) {
-    return distance_to_crease(s, x, y) < 0.1;
-  });
-  const Stats walls = stats_over(s, ao, [&](int x, int y) {
-    return distance_to_crease(s, x, y) > 1.2;
-  });
+  const Stats crease =
+      stats_over(s, ao, [&](int x, int y) { return distance_to_crease(s, x, y) < 0.1; });
+  const Stats walls =
+      stats_over(s, ao, [&](int x, int y) { return distance_to_crease(s, x, y) > 1.2; });
   // Measured 0.61: the band reaches 0.1 radius from the crease and the bias margin drops the
   // samples nearest the walls.
   EXPECT_NEAR(crease.mean, 0.5, 0.15);

@@ -16,8 +16,8 @@ namespace {
 
 // A floor with a wall behind it, seen from above at an angle: enough occlusion to compare runs.
 Scene floor_and_wall(const Camera& cam) {
-  return ray_cast(cam, {{{{0, -1, -6}, normalized({0, 1, 0.0})}},
-                        {{{0, 0, -8}, normalized({0, 0.2, 1})}}});
+  return ray_cast(
+      cam, {{{{0, -1, -6}, normalized({0, 1, 0.0})}}, {{{0, 0, -8}, normalized({0, 0.2, 1})}}});
 }
 
 bool contains(const char* haystack, const char* needle) {
@@ -171,8 +171,9 @@ TEST(Api, EmptyAndSinglePixelImages) {
 TEST(Api, HostileDepthValuesAreBackground) {
   const Camera cam;
   Scene s = floor_and_wall(cam);
-  const float hostile[] = {std::numeric_limits<float>::quiet_NaN(), HUGE_VALF, -HUGE_VALF, -3.0f,
-                           0.0f, 1e10f, 65504.0f, std::numeric_limits<float>::denorm_min()};
+  const float hostile[] = {
+      std::numeric_limits<float>::quiet_NaN(), HUGE_VALF, -HUGE_VALF, -3.0f, 0.0f, 1e10f, 65504.0f,
+      std::numeric_limits<float>::denorm_min()};
   const size_t n = s.depth.size();
   for (size_t i = 0; i < n; i += 7) s.depth[i] = hostile[(i / 7) % 8];
   for (const char* variant : {"hemisphere", "sphere"}) {
@@ -241,11 +242,11 @@ TEST(Api, StridedAndBottomUpImagesGiveTheSameResult) {
   Job job;
   job.camera(cam);
   job.set("normal_space", "camera");
-  ASSERT_EQ(ssao_job_set_image(job.get(), "depth", depth_rgba.data() + 3, w, h, 1, 16,
-                               row_floats * 4),
-            SSAO_OK);
-  ASSERT_EQ(ssao_job_set_image(job.get(), "normal", normal_up.data() + size_t(h - 1) * w * 4, w,
-                               h, 3, 16, -ptrdiff_t(w) * 16),
+  ASSERT_EQ(
+      ssao_job_set_image(job.get(), "depth", depth_rgba.data() + 3, w, h, 1, 16, row_floats * 4),
+      SSAO_OK);
+  ASSERT_EQ(ssao_job_set_image(job.get(), "normal", normal_up.data() + size_t(h - 1) * w * 4, w, h,
+                               3, 16, -ptrdiff_t(w) * 16),
             SSAO_OK);
   ASSERT_EQ(ssao_job_set_image(job.get(), "ao", ao_rgba.data(), w, h, 4, 0, 0), SSAO_OK);
   ASSERT_EQ(job.run(), SSAO_OK) << ssao_last_error();
@@ -282,8 +283,8 @@ TEST(Api, StrengthPowerAndRemapShapeTheResult) {
   const Camera cam;
   Scene s = floor_and_wall(cam);
   const auto raw = compute_ao(s, cam, 1.0, "hemisphere");
-  const auto none = compute_ao(s, cam, 1.0, "hemisphere", true,
-                               [](Job& j) { j.set("strength", 0.0); });
+  const auto none =
+      compute_ao(s, cam, 1.0, "hemisphere", true, [](Job& j) { j.set("strength", 0.0); });
   const auto shaped = compute_ao(s, cam, 1.0, "hemisphere", true, [](Job& j) {
     j.set("power", 2.0);
     j.set("strength", 0.5);

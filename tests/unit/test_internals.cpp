@@ -26,14 +26,122 @@ struct BlenderCase {
 
 // Printed by Blender 3.4.1: blender -b --factory-startup -P scripts/blender/camera_matrices.py
 const BlenderCase kBlenderCases[] = {
-    {"persp_auto_wide", false, 35.0, 36.0, 24.0, "AUTO", 0.0, 0.0, 6.0, 640, 360, 1, 1, {1.94444442, 0, 0, 0, 0, 3.45678997, 0, 0, 0, 0, -1.00019991, -0.20002, 0, 0, -1, 0}},
-    {"persp_auto_tall", false, 50.0, 36.0, 24.0, "AUTO", 0.0, 0.0, 6.0, 300, 500, 1, 1, {4.62962961, 0, 0, 0, 0, 2.77777767, 0, 0, 0, 0, -1.00019991, -0.20002, 0, 0, -1, 0}},
-    {"persp_shift", false, 28.0, 36.0, 24.0, "AUTO", 0.15, -0.1, 6.0, 320, 240, 1, 1, {1.55555546, 0, 0.300000012, 0, 0, 2.07407403, -0.26666671, 0, 0, 0, -1.00019991, -0.20002, 0, 0, -1, 0}},
-    {"persp_vertical", false, 40.0, 36.0, 24.0, "VERTICAL", 0.05, 0.2, 6.0, 400, 300, 1, 1, {2.5, 0, 0.0750000104, 0, 0, 3.33333325, 0.400000006, 0, 0, 0, -1.00019991, -0.20002, 0, 0, -1, 0}},
-    {"persp_horizontal_tall", false, 40.0, 30.0, 20.0, "HORIZONTAL", 0.0, 0.1, 6.0, 200, 400, 1, 1, {2.66666651, 0, 0, 0, 0, 1.33333325, 0.100000001, 0, 0, 0, -1.00019991, -0.20002, 0, 0, -1, 0}},
-    {"persp_pixel_aspect", false, 35.0, 36.0, 24.0, "AUTO", 0.1, 0.0, 6.0, 480, 480, 1, 1.25, {2.43055534, 0, 0.25000003, 0, 0, 1.94444418, 0, 0, 0, 0, -1.00019991, -0.20002, 0, 0, -1, 0}},
-    {"ortho_auto", true, 50.0, 36.0, 24.0, "AUTO", 0.0, 0.0, 7.5, 640, 360, 1, 1, {0.266666681, 0, 0, -0, 0, 0.474074066, 0, -0, 0, 0, -0.00200019986, -1.00019991, 0, 0, 0, 1}},
-    {"ortho_shift_vertical", true, 50.0, 36.0, 24.0, "VERTICAL", -0.2, 0.1, 4.0, 300, 400, 1, 1, {0.666666687, 0, 0, 0.533333302, 0, 0.50000006, 0, -0.200000003, 0, 0, -0.00200019986, -1.00019991, 0, 0, 0, 1}},
+    {"persp_auto_wide",
+     false,
+     35.0,
+     36.0,
+     24.0,
+     "AUTO",
+     0.0,
+     0.0,
+     6.0,
+     640,
+     360,
+     1,
+     1,
+     {1.94444442, 0, 0, 0, 0, 3.45678997, 0, 0, 0, 0, -1.00019991, -0.20002, 0, 0, -1, 0}},
+    {"persp_auto_tall",
+     false,
+     50.0,
+     36.0,
+     24.0,
+     "AUTO",
+     0.0,
+     0.0,
+     6.0,
+     300,
+     500,
+     1,
+     1,
+     {4.62962961, 0, 0, 0, 0, 2.77777767, 0, 0, 0, 0, -1.00019991, -0.20002, 0, 0, -1, 0}},
+    {"persp_shift",
+     false,
+     28.0,
+     36.0,
+     24.0,
+     "AUTO",
+     0.15,
+     -0.1,
+     6.0,
+     320,
+     240,
+     1,
+     1,
+     {1.55555546, 0, 0.300000012, 0, 0, 2.07407403, -0.26666671, 0, 0, 0, -1.00019991, -0.20002, 0,
+      0, -1, 0}},
+    {"persp_vertical",
+     false,
+     40.0,
+     36.0,
+     24.0,
+     "VERTICAL",
+     0.05,
+     0.2,
+     6.0,
+     400,
+     300,
+     1,
+     1,
+     {2.5, 0, 0.0750000104, 0, 0, 3.33333325, 0.400000006, 0, 0, 0, -1.00019991, -0.20002, 0, 0, -1,
+      0}},
+    {"persp_horizontal_tall",
+     false,
+     40.0,
+     30.0,
+     20.0,
+     "HORIZONTAL",
+     0.0,
+     0.1,
+     6.0,
+     200,
+     400,
+     1,
+     1,
+     {2.66666651, 0, 0, 0, 0, 1.33333325, 0.100000001, 0, 0, 0, -1.00019991, -0.20002, 0, 0, -1,
+      0}},
+    {"persp_pixel_aspect",
+     false,
+     35.0,
+     36.0,
+     24.0,
+     "AUTO",
+     0.1,
+     0.0,
+     6.0,
+     480,
+     480,
+     1,
+     1.25,
+     {2.43055534, 0, 0.25000003, 0, 0, 1.94444418, 0, 0, 0, 0, -1.00019991, -0.20002, 0, 0, -1, 0}},
+    {"ortho_auto",
+     true,
+     50.0,
+     36.0,
+     24.0,
+     "AUTO",
+     0.0,
+     0.0,
+     7.5,
+     640,
+     360,
+     1,
+     1,
+     {0.266666681, 0, 0, -0, 0, 0.474074066, 0, -0, 0, 0, -0.00200019986, -1.00019991, 0, 0, 0, 1}},
+    {"ortho_shift_vertical",
+     true,
+     50.0,
+     36.0,
+     24.0,
+     "VERTICAL",
+     -0.2,
+     0.1,
+     4.0,
+     300,
+     400,
+     1,
+     1,
+     {0.666666687, 0, 0, 0.533333302, 0, 0.50000006, 0, -0.200000003, 0, 0, -0.00200019986,
+      -1.00019991, 0, 0, 0, 1}},
 };
 
 }  // namespace
@@ -94,7 +202,8 @@ ssao_ref::DepthScene reference_scene(const Scene& s, const Camera& cam) {
   return r;
 }
 
-double rmse_over_geometry(const Scene& s, const std::vector<float>& a, const std::vector<float>& b) {
+double rmse_over_geometry(const Scene& s, const std::vector<float>& a,
+                          const std::vector<float>& b) {
   double sum = 0;
   int n = 0;
   for (size_t i = 0; i < a.size(); ++i) {
@@ -111,12 +220,12 @@ Scene boxes_scene(const Camera& cam) {
   const double c = std::cos(0.35), s = std::sin(0.35);
   auto tilt = [&](V3 p) { return V3{p.x, c * p.y - s * p.z, s * p.y + c * p.z}; };  // look down
   std::vector<Solid> solids = {
-      {{tilt({0, -1.5, 0}), tilt({0, 1, 0})}},                       // floor y = -1.5
-      {{tilt({0, 0, -10}), tilt({0, 0, 1})}},                        // wall z = -10
+      {{tilt({0, -1.5, 0}), tilt({0, 1, 0})}},  // floor y = -1.5
+      {{tilt({0, 0, -10}), tilt({0, 0, 1})}},   // wall z = -10
   };
-  for (Solid b : {box({-2.0, -1.5, -7.0}, {-0.8, -0.3, -5.8}),
-                  box({0.2, -1.5, -9.9}, {1.6, 0.5, -8.6}),
-                  box({1.0, -1.5, -6.0}, {1.5, -1.0, -5.5})}) {
+  for (Solid b :
+       {box({-2.0, -1.5, -7.0}, {-0.8, -0.3, -5.8}), box({0.2, -1.5, -9.9}, {1.6, 0.5, -8.6}),
+        box({1.0, -1.5, -6.0}, {1.5, -1.0, -5.5})}) {
     for (Plane& p : b) p = {tilt(p.point), tilt(p.normal)};
     solids.push_back(b);
   }
@@ -160,8 +269,10 @@ TEST(Reference, VariantsAgreeWithTheRayMarch) {
   const double e_sphere = rmse_over_geometry(s, sphere, truth);
   const double e_seed = rmse_over_geometry(s, seed, truth);
   const double e_none = rmse_over_geometry(s, unoccluded, truth);
-  std::printf("[ measure  ] RMSE vs ray march: hemisphere %.4f, sphere %.4f, seed hemisphere "
-              "%.4f, AO=1 %.4f\n", e_hemisphere, e_sphere, e_seed, e_none);
+  std::printf(
+      "[ measure  ] RMSE vs ray march: hemisphere %.4f, sphere %.4f, seed hemisphere "
+      "%.4f, AO=1 %.4f\n",
+      e_hemisphere, e_sphere, e_seed, e_none);
   EXPECT_GT(e_none, 0.1) << "the scene must have occlusion";
   EXPECT_LT(e_hemisphere, 0.06);  // measured: hemisphere 0.030, sphere 0.107, seed 0.099
   EXPECT_LT(e_hemisphere, 0.6 * e_seed);

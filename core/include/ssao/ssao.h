@@ -37,13 +37,13 @@
  * ------------------------------------------------------------------------------------------- */
 
 #if defined(_WIN32)
-#  if defined(SSAO_BUILDING_LIBRARY)
-#    define SSAO_API __declspec(dllexport)
-#  else
-#    define SSAO_API __declspec(dllimport)
-#  endif
+#if defined(SSAO_BUILDING_LIBRARY)
+#define SSAO_API __declspec(dllexport)
 #else
-#  define SSAO_API __attribute__((visibility("default")))
+#define SSAO_API __declspec(dllimport)
+#endif
+#else
+#define SSAO_API __attribute__((visibility("default")))
 #endif
 
 #define SSAO_VERSION_MAJOR 0
@@ -118,8 +118,7 @@ SSAO_API ssao_status ssao_job_get_int(ssao_job job, const char* name, int* out);
 SSAO_API ssao_status ssao_job_get_float(ssao_job job, const char* name, double* out);
 /* Copies the value (NUL-terminated, truncated to size) into out. */
 SSAO_API ssao_status ssao_job_get_string(ssao_job job, const char* name, char* out, size_t size);
-SSAO_API ssao_status ssao_job_get_floats(ssao_job job, const char* name, double* out,
-                                         size_t count);
+SSAO_API ssao_status ssao_job_get_floats(ssao_job job, const char* name, double* out, size_t count);
 
 /* Attaches (or, with data == NULL, detaches) an image. Names:
  *   "depth"     input, required, channel 0 read
