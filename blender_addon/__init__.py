@@ -1,0 +1,33 @@
+# SPDX-License-Identifier: MIT
+"""Ambient Occlusion (SSAO) compositor node, computed by libssao from the Depth and Normal passes.
+
+Blender 3.x installs this folder (zipped) as a legacy add-on (bl_info); Blender 4.2+ installs
+the same zip as an extension (blender_manifest.toml). All imports are relative.
+"""
+
+bl_info = {
+    "name": "Ambient Occlusion (SSAO) compositor node",
+    "author": "ssao project",
+    "version": (0, 1, 0),
+    "blender": (3, 4, 0),
+    "location": "Compositor > Add > Filter > Ambient Occlusion (SSAO)",
+    "description": "Screen-space ambient occlusion from the render's Depth and Normal passes",
+    "category": "Compositing",
+}
+
+from . import node, operators, pipeline  # noqa: E402
+
+# Scripting entry point: ssao_compositor.compute_ao(scene) -> numpy array (height, width).
+compute_ao = pipeline.compute_ao
+
+_modules = (node, pipeline, operators)
+
+
+def register():
+    for module in _modules:
+        module.register()
+
+
+def unregister():
+    for module in reversed(_modules):
+        module.unregister()

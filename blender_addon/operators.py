@@ -1,0 +1,36 @@
+# SPDX-License-Identifier: MIT
+"""Operators: recompute the AO of the scene's SSAO nodes from the last render's passes."""
+import bpy
+
+from . import pipeline
+
+
+class SSAO_OT_recompute(bpy.types.Operator):
+    """Recompute the ambient occlusion from the passes of the last render (no re-render)"""
+
+    bl_idname = "ssao.recompute"
+    bl_label = "Recompute SSAO"
+    bl_options = {'REGISTER'}
+
+    @classmethod
+    def poll(cls, context):
+        return context.scene is not None and bool(pipeline.ssao_nodes(context.scene))
+
+    def execute(self, context):
+        scene = context.scene
+        if pipeline.compute_frame(scene, scene.frame_current) == 0:
+            errors = [n.status for n in pipeline.ssao_nodes(scene)]
+            self.report({'ERROR'}, "; ".join(errors) or "nothing to compute")
+            return {'CANCELLED'}
+        for node in pipeline.ssao_nodes(scene):
+            pipeline.nudge_compositor(node)
+        self.report({'INFO'}, "SSAO recomputed")
+        return {'FINISHED'}
+
+
+def register():
+    bpy.utils.register_class(SSAO_OT_recompute)
+
+
+def unregister():
+    bpy.utils.unregister_class(SSAO_OT_recompute)
