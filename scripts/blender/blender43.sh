@@ -224,7 +224,7 @@ scene.render.resolution_x, scene.render.resolution_y = 64, 36
 scene.render.resolution_percentage = 100
 scene.eevee.taa_render_samples = 1
 bpy.ops.render.render()
-pixels = bpy.data.images['Render Result']
+assert bpy.data.images['Render Result']
 print('BLENDER43_EEVEE_OK')
 " 2>&1) || { printf '%s\n' "$out" | tail -n 20 >&2; return 1; }
   grep -q '^BLENDER43_EEVEE_OK' <<< "$out" || { printf '%s\n' "$out" | tail -n 20 >&2; return 1; }
@@ -387,7 +387,7 @@ run_blender() {
   cwd=/
   if is_covered "$PWD"; then
     cwd=$PWD
-  else
+  elif [[ "$PWD" != / ]]; then
     say "warning: the current directory $PWD is not visible inside; running from /"
   fi
   if [[ -n "${HOME:-}" && -d "$HOME" ]] && is_covered "$HOME"; then

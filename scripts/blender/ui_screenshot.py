@@ -134,19 +134,46 @@ def frame_node_tree(window, node):
         other.select = False
     node.select = True
     node.id_data.nodes.active = node
-    with bpy.context.temp_override(window=window, area=area, region=window_region(area)):
+    region = window_region(area)
+    with bpy.context.temp_override(window=window, area=area, region=region):
         bpy.ops.node.view_all()
+        # view_all centres the tree but leaves it small here: zoom in until it fills the region.
+        nodes = node.id_data.nodes
+        left = min(n.location.x for n in nodes)
+        right = max(n.location.x + n.dimensions.x for n in nodes)
+        top = max(n.location.y for n in nodes)
+        bottom = min(n.location.y - n.dimensions.y for n in nodes)
+        view = region.view2d
+        x0, y0 = view.region_to_view(0, 0)
+        x1, y1 = view.region_to_view(region.width, region.height)
+        need = max(1.1 * (right - left) / (x1 - x0), 1.1 * (top - bottom) / (y1 - y0))
+        if need < 0.95:  # zoom_in moves each side in by zoomfac x the view's size
+            factor = (1.0 - need) / 2.0
+            log(f'DEBUG zoom_in {bpy.ops.view2d.zoom_in(zoomfacx=factor, zoomfacy=factor)}')
+        # pan the tree's centre to the region's centre
+        x0, y0 = view.region_to_view(0, 0)
+        x1, y1 = view.region_to_view(region.width, region.height)
+        scale = region.width / (x1 - x0)
+        dx = ((left + right) / 2 - (x0 + x1) / 2) * scale
+        dy = ((top + bottom) / 2 - (y0 + y1) / 2) * scale
+        log(f'DEBUG pan {bpy.ops.view2d.pan(deltax=int(round(dx)), deltay=int(round(dy)))}')
+        log(f"DEBUG frame region {region.x},{region.y} {region.width}x{region.height} bbox {left},{bottom}..{right},{top} need {need} pan {dx},{dy} view {view.region_to_view(0, 0)} {view.region_to_view(region.width, region.height)} node at {view.view_to_region(*node.location, clip=False)}")
     return True
 
 
 def split_for_image_editor(window):
-    """Right part of the compositor editor becomes an Image Editor (for the Render Result)."""
+    """The compositor editor gets the whole window (the other areas are closed), and its right
+    part becomes an Image Editor (for the Render Result)."""
     area = find_area(window, "CompositorNodeTree")
     if area is None:
         raise RuntimeError("SPLIT needs a compositor Node Editor (use --workspace Compositing)")
+    for other in list(window.screen.areas):
+        if other.as_pointer() != area.as_pointer():
+            with bpy.context.temp_override(window=window, area=other):
+                bpy.ops.screen.area_close()
     before = set(a.as_pointer() for a in window.screen.areas)
     with bpy.context.temp_override(window=window, area=area, region=window_region(area)):
-        bpy.ops.screen.area_split(direction='VERTICAL', factor=0.45)
+        bpy.ops.screen.area_split(direction='VERTICAL', factor=0.56)
     new = [a for a in window.screen.areas if a.as_pointer() not in before]
     if not new:
         raise RuntimeError("area_split made no area")
@@ -182,6 +209,10 @@ def image_editors(window_manager):
 
 def screenshot(window, path):
     area = window.screen.areas[0]
+    for a in window.screen.areas:
+        for r in a.regions:
+            if r.type == 'WINDOW':
+                log(f"DEBUG shot {a.ui_type} {r.x},{r.y} {r.width}x{r.height} {r.view2d.region_to_view(0, 0)} {r.view2d.region_to_view(r.width, r.height)}")
     with bpy.context.temp_override(window=window, area=area):
         bpy.ops.screen.screenshot(filepath=path, check_existing=False)
     log(f"saved {path}")
@@ -228,8 +259,9 @@ def compare(exr_path, ao):
         idx = [names.index(f"{prefix}.{c}") for c in "RGB" if f"{prefix}.{c}" in names]
         return pixels[:, :, idx] if len(idx) == 3 else None
 
-    combined = next((channels(p) for p in [n.rsplit(".", 1)[0] for n in names
-                                           if n.endswith(".Combined.R")]), None)
+    layers = [n[:-len(".R")] for n in names
+              if n.endswith(".Combined.R") and not n.startswith("Composite.")]
+    combined = channels(layers[0]) if layers else None
     composite = channels("Composite.Combined")
     result = {"channels": len(names)}
     if combined is None or composite is None:
@@ -271,6 +303,7 @@ def scenario():
     node = ssao_node(scene)
     prefs = bpy.context.preferences
     prefs.use_preferences_save = False  # never write the user's preferences
+    prefs.view.smooth_view = 0  # framing takes effect at once
     REPORT["workspace"] = ARGS.workspace
     window.workspace = bpy.data.workspaces[ARGS.workspace]
     yield 0.5
@@ -282,7 +315,10 @@ def scenario():
     yield 0.5
     REPORT["compositor_editor_open"] = frame_node_tree(window, node)
     REPORT["status_before"] = node.status
-    yield 0.5
+    for i in range(6):
+        yield 0.25
+        a = find_area(window, "CompositorNodeTree"); r = window_region(a)
+        log(f"DEBUG t view {r.view2d.region_to_view(0, 0)} {r.view2d.region_to_view(r.width, r.height)}")
 
     # F12
     log("render (F12)")
@@ -309,6 +345,8 @@ def scenario():
     REPORT["after_render"] = check("after_render", scene, node, t_ao)
     REPORT["image_editors"] = image_editors(bpy.context.window_manager)
 
+    frame_node_tree(window, node)  # again: the areas have their final sizes now
+    yield 1.0
     screenshot(window, os.path.join(OUT, "compositor_node.png"))
     for index, other in enumerate(bpy.context.window_manager.windows[1:], start=1):
         screenshot(other, os.path.join(OUT, f"window_{index}.png"))

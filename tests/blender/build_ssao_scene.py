@@ -41,9 +41,10 @@ def parse_args():
 
 
 def eevee_engine_name():
-    return "BLENDER_EEVEE_NEXT" if bpy.app.version >= (4, 2, 0) and \
-        "BLENDER_EEVEE_NEXT" in {e.bl_idname for e in bpy.types.RenderEngine.__subclasses__()} \
-        else "BLENDER_EEVEE"
+    """EEVEE is BLENDER_EEVEE_NEXT in Blender 4.2 to 4.x, BLENDER_EEVEE before and after."""
+    engines = {item.identifier for item in
+               bpy.types.RenderSettings.bl_rna.properties["engine"].enum_items}
+    return "BLENDER_EEVEE_NEXT" if "BLENDER_EEVEE_NEXT" in engines else "BLENDER_EEVEE"
 
 
 def main():
