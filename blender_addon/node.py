@@ -136,6 +136,8 @@ def _build_inner_tree(ssao_id):
     for axis, channel in zip(("X", "Y", "Z"), ("Red", "Green", "Blue")):
         links.new(separate.outputs[axis], combine.inputs[channel])
     links.new(group_in.outputs["Depth"], combine.inputs["Alpha"])
+    if not exporter.inputs and hasattr(exporter, "file_output_items"):  # Blender 5.0+
+        exporter.file_output_items.new('RGBA', "Passes")
     links.new(combine.outputs[0], exporter.inputs[0])
 
     ao = nodes.new("CompositorNodeImage")

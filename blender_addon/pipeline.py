@@ -95,8 +95,12 @@ def configure_node(node):
     if exporter is None:
         return
     os.makedirs(EXPORT_DIR, exist_ok=True)
-    exporter.base_path = EXPORT_DIR + os.sep
-    exporter.file_slots[0].path = f"ssao_{node.ssao_id}_"
+    if hasattr(exporter, "file_slots"):  # Blender 3.x and 4.x
+        exporter.base_path = EXPORT_DIR + os.sep
+        exporter.file_slots[0].path = f"ssao_{node.ssao_id}_"
+    else:  # Blender 5.0 renamed them (not tested here: no 5.x on Debian)
+        exporter.directory = EXPORT_DIR
+        exporter.file_name = f"ssao_{node.ssao_id}_"
     settings = exporter.format
     settings.file_format = 'OPEN_EXR'
     settings.color_mode = 'RGBA'

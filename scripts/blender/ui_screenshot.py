@@ -122,42 +122,50 @@ def ssao_node(scene):
     return nodes[0]
 
 
+def tidy_node_editor(window):
+    """No backdrop, no sidebar. Region sizes change at the next redraw, which shifts the view:
+    frame the tree in a later timer step."""
+    area = find_area(window, "CompositorNodeTree")
+    if area is not None:
+        area.spaces.active.show_backdrop = False
+        area.spaces.active.show_region_ui = False
+    return area is not None
+
+
 def frame_node_tree(window, node):
     """Selects the SSAO node (active) and frames the whole tree in the compositor editor."""
     area = find_area(window, "CompositorNodeTree")
     if area is None:
         return False
-    space = area.spaces.active
-    space.show_backdrop = False
-    space.show_region_ui = False
-    for other in node.id_data.nodes:
+    tree = node.id_data
+    for other in tree.nodes:
         other.select = False
     node.select = True
-    node.id_data.nodes.active = node
+    tree.nodes.active = node
     region = window_region(area)
+    view = region.view2d
+    left = min(n.location.x for n in tree.nodes)
+    right = max(n.location.x + n.dimensions.x for n in tree.nodes)
+    top = max(n.location.y for n in tree.nodes)
+    bottom = min(n.location.y - n.dimensions.y for n in tree.nodes)
+
+    def fraction():  # of the visible view the tree (plus a margin) needs
+        x0, y0 = view.region_to_view(0, 0)
+        x1, y1 = view.region_to_view(region.width, region.height)
+        return max(1.1 * (right - left) / (x1 - x0), 1.1 * (top - bottom) / (y1 - y0))
+
     with bpy.context.temp_override(window=window, area=area, region=region):
         bpy.ops.node.view_all()
-        # view_all centres the tree but leaves it small here: zoom in until it fills the region.
-        nodes = node.id_data.nodes
-        left = min(n.location.x for n in nodes)
-        right = max(n.location.x + n.dimensions.x for n in nodes)
-        top = max(n.location.y for n in nodes)
-        bottom = min(n.location.y - n.dimensions.y for n in nodes)
-        view = region.view2d
+        # view_all leaves the tree small here; zoom_in steps by a fixed 7.5 % a side.
+        for _ in range(40):
+            if fraction() > 0.92:
+                break
+            bpy.ops.view2d.zoom_in()
         x0, y0 = view.region_to_view(0, 0)
         x1, y1 = view.region_to_view(region.width, region.height)
-        need = max(1.1 * (right - left) / (x1 - x0), 1.1 * (top - bottom) / (y1 - y0))
-        if need < 0.95:  # zoom_in moves each side in by zoomfac x the view's size
-            factor = (1.0 - need) / 2.0
-            log(f'DEBUG zoom_in {bpy.ops.view2d.zoom_in(zoomfacx=factor, zoomfacy=factor)}')
-        # pan the tree's centre to the region's centre
-        x0, y0 = view.region_to_view(0, 0)
-        x1, y1 = view.region_to_view(region.width, region.height)
-        scale = region.width / (x1 - x0)
-        dx = ((left + right) / 2 - (x0 + x1) / 2) * scale
-        dy = ((top + bottom) / 2 - (y0 + y1) / 2) * scale
-        log(f'DEBUG pan {bpy.ops.view2d.pan(deltax=int(round(dx)), deltay=int(round(dy)))}')
-        log(f"DEBUG frame region {region.x},{region.y} {region.width}x{region.height} bbox {left},{bottom}..{right},{top} need {need} pan {dx},{dy} view {view.region_to_view(0, 0)} {view.region_to_view(region.width, region.height)} node at {view.view_to_region(*node.location, clip=False)}")
+        scale = region.width / (x1 - x0)  # pixels per view unit
+        bpy.ops.view2d.pan(deltax=round(((left + right) - (x0 + x1)) / 2 * scale),
+                           deltay=round(((top + bottom) - (y0 + y1)) / 2 * scale))
     return True
 
 
@@ -209,10 +217,7 @@ def image_editors(window_manager):
 
 def screenshot(window, path):
     area = window.screen.areas[0]
-    for a in window.screen.areas:
-        for r in a.regions:
-            if r.type == 'WINDOW':
-                log(f"DEBUG shot {a.ui_type} {r.x},{r.y} {r.width}x{r.height} {r.view2d.region_to_view(0, 0)} {r.view2d.region_to_view(r.width, r.height)}")
+
     with bpy.context.temp_override(window=window, area=area):
         bpy.ops.screen.screenshot(filepath=path, check_existing=False)
     log(f"saved {path}")
@@ -313,12 +318,11 @@ def scenario():
     else:
         prefs.view.render_display_type = ARGS.render_display
     yield 0.5
+    tidy_node_editor(window)
+    yield 0.5
     REPORT["compositor_editor_open"] = frame_node_tree(window, node)
     REPORT["status_before"] = node.status
-    for i in range(6):
-        yield 0.25
-        a = find_area(window, "CompositorNodeTree"); r = window_region(a)
-        log(f"DEBUG t view {r.view2d.region_to_view(0, 0)} {r.view2d.region_to_view(r.width, r.height)}")
+    yield 0.5
 
     # F12
     log("render (F12)")
