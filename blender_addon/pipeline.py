@@ -24,7 +24,9 @@ from . import ssao_native
 
 NODE_IDNAME = "CompositorNodeSSAO"
 # Where exporters write (per process; $SSAO_COMPOSITOR_EXPORT_DIR overrides it, e.g. to keep
-# the passes for the command-line tool).
+# the passes for the command-line tool). Saved files carry SAVED_EXPORT_DIR instead, a folder
+# that exists for any session on the machine, with or without the add-on.
+SAVED_EXPORT_DIR = os.path.join(tempfile.gettempdir(), "ssao_compositor")
 EXPORT_DIR = os.environ.get("SSAO_COMPOSITOR_EXPORT_DIR") or \
     os.path.join(tempfile.gettempdir(), f"ssao_compositor_{os.getpid()}")
 # EEVEE writes its Depth pass as half floats with 65504 (the largest half) on the background.
@@ -69,7 +71,15 @@ def _inner(node, name):
 
 
 def export_path(node, frame):
-    return os.path.join(EXPORT_DIR, f"ssao_{node.ssao_id}_{frame:04d}.exr")
+    """Where the node's exporter writes `frame`, from its own settings (a file saved by another
+    session, or opened before the add-on was enabled, keeps the folder it was saved with)."""
+    from .node import EXPORT_NODE
+    exporter = _inner(node, EXPORT_NODE)
+    if hasattr(exporter, "file_slots"):
+        folder, name = exporter.base_path, exporter.file_slots[0].path
+    else:  # Blender 5.0+
+        folder, name = exporter.directory, exporter.file_name
+    return os.path.join(bpy.path.abspath(folder), f"{name}{frame:04d}.exr")
 
 
 def ao_image(node, width, height):
@@ -94,13 +104,7 @@ def configure_node(node):
     exporter = _inner(node, EXPORT_NODE)
     if exporter is None:
         return
-    os.makedirs(EXPORT_DIR, exist_ok=True)
-    if hasattr(exporter, "file_slots"):  # Blender 3.x and 4.x
-        exporter.base_path = EXPORT_DIR + os.sep
-        exporter.file_slots[0].path = f"ssao_{node.ssao_id}_"
-    else:  # Blender 5.0 renamed them (not tested here: no 5.x on Debian)
-        exporter.directory = EXPORT_DIR
-        exporter.file_name = f"ssao_{node.ssao_id}_"
+    _point_exporter(exporter, EXPORT_DIR, node.ssao_id)
     settings = exporter.format
     settings.file_format = 'OPEN_EXR'
     settings.color_mode = 'RGBA'
@@ -110,6 +114,24 @@ def configure_node(node):
     scene = node.id_data and _scene_of_tree(node.id_data)
     if scene is not None:
         ao_image(node, *camera_module.render_size(scene))
+
+
+def _point_exporter(exporter, folder, ssao_id):
+    os.makedirs(folder, exist_ok=True)
+    if hasattr(exporter, "file_slots"):  # Blender 3.x and 4.x
+        exporter.base_path = folder + os.sep
+        exporter.file_slots[0].path = f"ssao_{ssao_id}_"
+    else:  # Blender 5.0 renamed them (not tested here: no 5.x on Debian)
+        exporter.directory = folder
+        exporter.file_name = f"ssao_{ssao_id}_"
+
+
+def _point_exporters(folder):
+    from .node import EXPORT_NODE
+    for _, node in _all_ssao_nodes():
+        exporter = _inner(node, EXPORT_NODE)
+        if exporter is not None:
+            _point_exporter(exporter, folder, node.ssao_id)
 
 
 def forget_node(node):
@@ -417,8 +439,9 @@ def _on_load_post(*_):
 
 @bpy.app.handlers.persistent
 def _on_save_pre(*_):
-    # The AO must travel inside the .blend; exporters are muted so that a file opened without
-    # the add-on does not write into this process's (stale) folder.
+    # The AO must travel inside the .blend; exporters point at a folder every session has, so
+    # that a file opened without the add-on (or before it is enabled) writes somewhere harmless
+    # and, with the add-on, where it will look.
     from .node import AO_NODE
     # The re-compositing helpers are rebuilt when needed: keep them out of the user's file.
     for helper in [s for s in bpy.data.scenes if s.name.startswith(".SSAO recomposite ")]:
@@ -431,12 +454,12 @@ def _on_save_pre(*_):
         # that does not exist and drop the pixels.
         if image is not None and image.has_data and (image.is_dirty or not image.packed_file):
             image.pack()
-    _set_exporters_muted(True)
+    _point_exporters(SAVED_EXPORT_DIR)
 
 
 @bpy.app.handlers.persistent
 def _on_save_post(*_):
-    _set_exporters_muted(False)
+    _point_exporters(EXPORT_DIR)
 
 
 _HANDLERS = (("render_post", _on_render_post), ("render_write", _on_render_write),

@@ -6,7 +6,7 @@ a screenshot of the window.
     xvfb-run -a -s "-screen 0 1600x900x24" blender --factory-startup -noaudio \
         --addons ssao_compositor SCENE.blend --python scripts/blender/ui_screenshot.py -- \
         --out DIR [--workspace Compositing|Layout] [--render-display SPLIT|WINDOW|NONE]
-        [--change radius=1.5] [--timeout 240]
+        [--after-workspace NAME] [--change radius=1.5] [--timeout 240]
 
 SCENE.blend is a scene whose compositor has an SSAO node between Render Layers and Composite
 (tests/blender/build_ssao_scene.py makes one; with BLENDER_USER_SCRIPTS pointing at a folder
@@ -14,23 +14,27 @@ whose addons/ holds ssao_compositor when it is not installed in the user's profi
 
 Everything runs from timers once the UI is up:
   1. layout: the given workspace ("Compositing" has a compositor Node Editor, "Layout" has
-     none). With --render-display SPLIT (default) the compositor editor is split and its right
-     half becomes an Image Editor that shows the Render Result, and F12 renders into it
-     (preferences: render display "Keep User Interface"); WINDOW is Blender's default (F12
-     opens a new window with an Image Editor); NONE renders with no Image Editor at all.
-     The SSAO node is selected and the node tree framed.
+     none). With --render-display SPLIT (default; needs Compositing) the compositor editor
+     gets the window, its right part becomes an Image Editor showing the Render Result, and F12
+     renders into it (preferences: render in "Keep User Interface"); WINDOW is Blender's
+     default (F12 opens a new window with an Image Editor); NONE renders with no Image Editor.
+     The SSAO node is selected and the node tree framed (its properties are on the node).
   2. F12: bpy.ops.render.render('INVOKE_DEFAULT'); waits for the render job, then for the
-     add-on's main-thread timer (the node's status "Frame N: ... ms") and for the compositor
-     jobs that follow (composite_post handler), then for quiet.
+     add-on's main-thread timer (the node's status "Frame N: ... ms"), then until no render or
+     compositor job ran for --settle seconds (compositor jobs are counted with composite_post).
   3. check: saves the Render Result as a multilayer EXR (its Combined pass = the beauty, its
      Composite layer = what the compositor made) and compares Composite with Combined x AO
      (the node's AO image): "AO applied" when they agree to 1e-3.
-  4. --change NAME=VALUE: sets that node property (its update callback recomputes from the
-     exported passes and nudges the compositor), waits, checks again, and counts the renders
-     that ran meanwhile (must be 0).
-  5. screenshots: DIR/compositor_node.png (the main window) and DIR/window_N.png for any other
-     window (the render window with --render-display WINDOW); DIR/ui_report.json holds every
-     measurement, DIR/ui_events.txt the handler events with times. Then quits.
+  4. screenshots: DIR/compositor_node.png (the main window, bpy.ops.screen.screenshot),
+     DIR/window_N.png for any other window (the render window with WINDOW; these come out
+     garbled under Xvfb), DIR/screen.png (the whole X screen through ImageMagick's `import`,
+     when installed: every window as the user sees it).
+  5. --after-workspace NAME: switches the main window to that workspace, waits, checks again.
+  6. --change NAME=VALUE: sets that node property (its update callback recomputes from the
+     exported passes and nudges the compositor), waits, checks again, counts the renders that
+     ran meanwhile (should be 0), and saves DIR/after_change.png.
+  7. prints "ui_screenshot [...] RESULT ..." lines, writes DIR/ui_report.json (every
+     measurement) and DIR/ui_events.txt (handler events with times), and quits.
 
 Exit status: 0 when the run completed (whatever the checks found: read ui_report.json);
 1 on a timeout or an exception. The comparison needs numpy and OpenImageIO importable in
@@ -57,6 +61,8 @@ def parse_args():
     parser.add_argument("--workspace", default="Compositing")
     parser.add_argument("--render-display", choices=("SPLIT", "WINDOW", "NONE"),
                         default="SPLIT")
+    parser.add_argument("--after-workspace", default="",
+                        help="switch to this workspace after the render, then check again")
     parser.add_argument("--change", default="radius=1.5",
                         help="NAME=VALUE node property to change after the render ('' skips)")
     parser.add_argument("--timeout", type=float, default=240.0, help="seconds for everything")
@@ -217,10 +223,21 @@ def image_editors(window_manager):
 
 def screenshot(window, path):
     area = window.screen.areas[0]
-
     with bpy.context.temp_override(window=window, area=area):
         bpy.ops.screen.screenshot(filepath=path, check_existing=False)
     log(f"saved {path}")
+
+
+def screenshot_x_root(path):
+    """The whole X screen, every window as X shows it (ImageMagick's import), when available."""
+    import shutil
+    import subprocess
+    tool = shutil.which("import")
+    if not tool or not os.environ.get("DISPLAY"):
+        return
+    result = subprocess.run([tool, "-window", "root", path], capture_output=True, text=True,
+                            timeout=60)
+    log(f"saved {path}" if result.returncode == 0 else f"import failed: {result.stderr}")
 
 
 # --- checking the Render Result --------------------------------------------------------------
@@ -337,16 +354,16 @@ def scenario():
     yield from wait_until(lambda: not bpy.app.is_job_running('RENDER'), "the render job")
     REPORT["render_seconds"] = now() - t_render
     log(f"render done in {REPORT['render_seconds']:.1f} s; waiting for the add-on")
+    t_post = min(t for t, n in EVENTS if n == "render_post" and t >= t_render)
     yield from wait_until(lambda: node.status.startswith(("Frame", "Error")),
                           "the add-on's AO computation")
-    t_ao = now()
     REPORT["status_after_render"] = node.status
     log(f"node status: {node.status}")
-    yield from wait_quiet(t_ao)
+    yield from wait_quiet(now())
     if ARGS.render_display == "SPLIT":
         show_render_result(window)
         yield 0.5
-    REPORT["after_render"] = check("after_render", scene, node, t_ao)
+    REPORT["after_render"] = check("after_render", scene, node, t_post)
     REPORT["image_editors"] = image_editors(bpy.context.window_manager)
 
     frame_node_tree(window, node)  # again: the areas have their final sizes now
@@ -354,6 +371,16 @@ def scenario():
     screenshot(window, os.path.join(OUT, "compositor_node.png"))
     for index, other in enumerate(bpy.context.window_manager.windows[1:], start=1):
         screenshot(other, os.path.join(OUT, f"window_{index}.png"))
+    screenshot_x_root(os.path.join(OUT, "screen.png"))
+
+    # a workspace switch after the render (e.g. from Layout to Compositing)
+    if ARGS.after_workspace:
+        t_switch = now()
+        window.workspace = bpy.data.workspaces[ARGS.after_workspace]
+        log(f"switched to workspace {ARGS.after_workspace}")
+        yield 1.0
+        yield from wait_quiet(t_switch)
+        REPORT["after_workspace"] = check("after_workspace", scene, node, t_switch)
 
     # a property change: recompute from the exported passes, no render
     if ARGS.change:
@@ -381,7 +408,28 @@ def check(label, scene, node, since):
     return result
 
 
+def verdict(result):
+    if not result:
+        return "not checked"
+    if "ao_applied" not in result:
+        return result.get("skipped") or result.get("error", "?")
+    difference = result["max_abs_composite_minus_combined_x_ao"]
+    return ("AO applied" if result["ao_applied"] else "AO NOT applied") + \
+        f" (max |Composite - Combined x AO| {difference:.2g}," \
+        f" compositor jobs {result['compositor_jobs_since']})"
+
+
 def finish(code):
+    log(f"RESULT workspace {ARGS.workspace}, render display {ARGS.render_display}: "
+        f"after F12: {verdict(REPORT.get('after_render'))}")
+    if ARGS.after_workspace:
+        log(f"RESULT after switching to {ARGS.after_workspace}: "
+            f"{verdict(REPORT.get('after_workspace'))}")
+    if "change" in REPORT:
+        change = REPORT["change"]
+        log(f"RESULT after {change['property']} {change['old']!r} -> {change['new']!r}: "
+            f"{verdict(change.get('check'))}, renders meanwhile "
+            f"{change.get('renders_meanwhile')}")
     REPORT["seconds"] = now()
     REPORT["exit_code"] = code
     with open(os.path.join(OUT, "ui_report.json"), "w") as stream:

@@ -214,11 +214,15 @@ class AddonTest(unittest.TestCase):
         for path in glob.glob(os.path.join(folder, "out_*.exr")) + \
                 glob.glob(os.path.join(folder, "passes", "*.exr")):
             os.remove(path)
+        # Saved once more by a session that computed nothing: the packed AO must survive.
+        resaved = os.path.join(folder, "resaved.blend")
+        self.blender.run(saved, "--python-exit-code", "1", "--python-expr",
+                         f"import bpy; bpy.ops.wm.save_as_mainfile(filepath={resaved!r})")
         # A Blender without the add-on: no --addons, empty user folders.
-        log = self.blender.run(saved, "-f", "1", addon=False, env={
+        log = self.blender.run(resaved, "-f", "1", addon=False, env={
             "BLENDER_USER_SCRIPTS": self.folder("reopen/no_addon"),
             "BLENDER_USER_EXTENSIONS": self.folder("reopen/no_extensions")})
-        self.assertNotIn("ssao_compositor", log)
+        self.assertNotIn("ssao_compositor:", log)  # the add-on's messages: it is not there
         # The node is undefined there, but its inner tree still multiplies by the packed AO (the
         # undefined node's AO socket feeds nothing, so compare the composite with the beauty).
         out = rgb(read_exr(os.path.join(folder, "out_0001.exr")))
@@ -227,6 +231,18 @@ class AddonTest(unittest.TestCase):
         ratio = out[:, :, 0][lit] / beauty[:, :, 0][lit]
         np.testing.assert_allclose(ratio, ao_with[lit], atol=1e-4)
         self.assertLess(float(ao_with[lit].mean()), 0.97, "there is AO to keep")
+
+    def test_addon_enabled_after_loading_the_file(self):
+        # blender -b file.blend --addons ...: the file is loaded before the add-on registers.
+        folder = self.folder("late")
+        blend = self.blender.build_scene("late/scene", "--output",
+                                         os.path.join(folder, "out_####.exr"),
+                                         "--passes-dir", os.path.join(folder, "passes"))
+        log = self.blender.run(blend, "--addons", self.blender.module, "-f", "1", addon=False)
+        self.assertIn("with AO", log)
+        ao, _ = self.assert_composite_is_beauty_times_ao(
+            os.path.join(folder, "out_0001.exr"), os.path.join(folder, "passes", "0001.exr"))
+        self.assertLess(float(ao.mean()), 0.97)
 
     def test_compute_ao_function_returns_numpy(self):
         folder = self.folder("script")
