@@ -105,6 +105,7 @@ class CompositorNodeSSAO(bpy.types.CompositorNodeCustomGroup):
         for name in self.bl_rna.properties.keys():
             if name in NODE_PARAMETERS:
                 layout.prop(self, name)
+        layout.operator("ssao.recompute", icon='FILE_REFRESH')
         if self.status:
             layout.label(text=self.status, icon='ERROR' if self.status.startswith("Error")
                          else 'INFO')

@@ -12,7 +12,9 @@ During a render the node's inner File Output ("exporter") writes the Depth and N
 Changing a node property recomputes from the exported passes, without rendering.
 (Measured facts behind this design: shared docs/blender-notes.md; ours: docs/blender.md.)
 """
+import atexit
 import os
+import shutil
 import tempfile
 import time
 
@@ -91,6 +93,8 @@ def ao_image(node, width, height):
         image = bpy.data.images.new(f".SSAO AO {node.ssao_id}", width, height, alpha=False,
                                     float_buffer=True)
         image.colorspace_settings.name = 'Non-Color'
+        # Until an AO is computed the node leaves the image as it is (not black).
+        image.pixels.foreach_set(np.ones(width * height * 4, np.float32))
         holder.image = image
     elif tuple(image.size) != (width, height):
         image.scale(width, height)
@@ -117,7 +121,7 @@ def configure_node(node):
 
 
 def _point_exporter(exporter, folder, ssao_id):
-    os.makedirs(folder, exist_ok=True)
+    # No folder is made here: the File Output node makes it when it first writes.
     if hasattr(exporter, "file_slots"):  # Blender 3.x and 4.x
         exporter.base_path = folder + os.sep
         exporter.file_slots[0].path = f"ssao_{ssao_id}_"
@@ -428,7 +432,23 @@ def _process_pending():
         if scene is not None and compute_frame(scene, frame) > 0:
             for node in ssao_nodes(scene):
                 nudge_compositor(node)
+            if not _compositor_editor_open():
+                message = ("AO computed; open a compositor Node Editor (and an Image Editor "
+                           "showing Render Result) to see it applied")
+                for node in ssao_nodes(scene):
+                    node.status = message
+                report(message)
     return None
+
+
+def _compositor_editor_open():
+    """Blender 3.4 re-composites only from a visible compositor Node Editor."""
+    for window in bpy.context.window_manager.windows:
+        for area in window.screen.areas:
+            for space in area.spaces:
+                if space.type == 'NODE_EDITOR' and space.tree_type == "CompositorNodeTree":
+                    return True
+    return False
 
 
 @bpy.app.handlers.persistent
@@ -470,7 +490,9 @@ _HANDLERS = (("render_post", _on_render_post), ("render_write", _on_render_write
 def register():
     for name, handler in _HANDLERS:
         getattr(bpy.app.handlers, name).append(handler)
-    os.makedirs(EXPORT_DIR, exist_ok=True)
+    if not os.environ.get("SSAO_COMPOSITOR_EXPORT_DIR"):
+        # This session's exports are of no use to any other: remove them when Blender quits.
+        atexit.register(shutil.rmtree, EXPORT_DIR, ignore_errors=True)
     # Nodes of a file that is already open (enabling the add-on after loading).
     try:
         for _, node in _all_ssao_nodes():
