@@ -333,9 +333,13 @@ def _read_passes_from(helper, passes_path, source_scene):
         tree.nodes.remove(rl)
 
 
-def _save_passes(result, scene, path):
-    """Writes every pass of `scene`'s Render Result to a multilayer EXR. save_render takes the
-    render of the scene it is given, with that scene's output settings: switch them briefly."""
+def save_passes(scene, path):
+    """Writes every pass of `scene`'s Render Result (and its Composite) to a 32-bit multilayer
+    EXR. save_render takes the render of the scene it is given, with that scene's output
+    settings: switch them briefly."""
+    result = bpy.data.images.get("Render Result")
+    if result is None:
+        raise RuntimeError("no Render Result")
     settings = scene.render.image_settings
     saved = (settings.file_format, settings.color_depth, settings.exr_codec)
     try:
@@ -350,13 +354,10 @@ def _save_passes(result, scene, path):
 def recomposite(scene):
     """Re-runs only the compositor of `scene` on its last render (headless)."""
     global _busy
-    result = bpy.data.images.get("Render Result")
-    if result is None:
-        raise RuntimeError("no Render Result to re-composite")
     helper = _helper_scene(scene)
     os.makedirs(EXPORT_DIR, exist_ok=True)
     passes_path = os.path.join(EXPORT_DIR, f"passes_{abs(hash(scene.name))}.exr")
-    _save_passes(result, scene, passes_path)
+    save_passes(scene, passes_path)
     _read_passes_from(helper, passes_path, scene)
     _busy = True
     _set_exporters_muted(True)

@@ -240,19 +240,16 @@ def screenshot_x_root(path):
     log(f"saved {path}" if result.returncode == 0 else f"import failed: {result.stderr}")
 
 
+def addon_pipeline():
+    """The enabled add-on's pipeline module (legacy or extension name)."""
+    return next(m for n, m in sys.modules.items() if n.endswith("ssao_compositor.pipeline"))
+
+
 # --- checking the Render Result --------------------------------------------------------------
 
 def save_render_result(scene, path):
     """The Render Result as a 32-bit multilayer EXR (all passes and the Composite layer)."""
-    settings = scene.render.image_settings
-    saved = (settings.file_format, settings.color_depth, settings.exr_codec)
-    try:
-        settings.file_format = 'OPEN_EXR_MULTILAYER'
-        settings.color_depth = '32'
-        settings.exr_codec = 'ZIP'
-        bpy.data.images["Render Result"].save_render(path, scene=scene)
-    finally:
-        settings.file_format, settings.color_depth, settings.exr_codec = saved
+    addon_pipeline().save_passes(scene, path)
 
 
 def node_ao(node):

@@ -98,6 +98,19 @@ class AddonTest(unittest.TestCase):
         os.makedirs(path, exist_ok=True)
         return path
 
+    def render_scene(self, name, *options):
+        """Builds scene `name` (build_ssao_scene.py options), renders frame 1 to an EXR, checks
+        that the frame equals beauty x the node's AO, and returns (folder, AO, passes)."""
+        folder = self.folder(name)
+        blend = self.blender.build_scene(f"{name}/scene", *options,
+                                         "--output", os.path.join(folder, "out_####.exr"),
+                                         "--passes-dir", os.path.join(folder, "passes"))
+        log = self.render_frame(blend, folder)
+        self.assertIn("with AO", log)
+        ao, passes = self.assert_composite_is_beauty_times_ao(
+            os.path.join(folder, "out_0001.exr"), os.path.join(folder, "passes", "0001.exr"))
+        return folder, ao, passes
+
     def render_frame(self, blend, folder, *args, frame=1):
         """Renders `blend` (-f frame, or extra args) with the node's exports kept in folder."""
         env = {"SSAO_COMPOSITOR_EXPORT_DIR": os.path.join(folder, "export")}
@@ -134,14 +147,7 @@ class AddonTest(unittest.TestCase):
         self.assertRegex(output, r"MENU NODE_MT_category_\w+ [1-9]")
 
     def test_render_composites_beauty_times_ao_equal_to_the_cli(self):
-        folder = self.folder("cycles")
-        blend = self.blender.build_scene("cycles/scene", "--samples", "128", "--ao-pass",
-                                         "--output", os.path.join(folder, "out_####.exr"),
-                                         "--passes-dir", os.path.join(folder, "passes"))
-        log = self.render_frame(blend, folder)
-        self.assertIn("with AO", log)
-        ao, passes = self.assert_composite_is_beauty_times_ao(
-            os.path.join(folder, "out_0001.exr"), os.path.join(folder, "passes", "0001.exr"))
+        folder, ao, passes = self.render_scene("cycles", "--samples", "128", "--ao-pass")
         # The same passes through the command-line tool give the same AO (same library, same
         # parameters: the node's defaults are the library's).
         cli = self.cli_ao(folder, os.path.join(folder, "scene.camera.json"))
@@ -156,24 +162,12 @@ class AddonTest(unittest.TestCase):
         self.assertLess(float(ao[geometry].mean()), 0.97)
 
     def test_orthographic_camera(self):
-        folder = self.folder("ortho")
-        blend = self.blender.build_scene("ortho/scene", "--camera", "ortho",
-                                         "--output", os.path.join(folder, "out_####.exr"),
-                                         "--passes-dir", os.path.join(folder, "passes"))
-        self.render_frame(blend, folder)
-        ao, _ = self.assert_composite_is_beauty_times_ao(
-            os.path.join(folder, "out_0001.exr"), os.path.join(folder, "passes", "0001.exr"))
-        np.testing.assert_allclose(ao, self.cli_ao(folder, os.path.join(folder, "scene.camera.json")),
-                                   atol=1e-5)
+        folder, ao, _ = self.render_scene("ortho", "--camera", "ortho")
+        cli = self.cli_ao(folder, os.path.join(folder, "scene.camera.json"))
+        np.testing.assert_allclose(ao, cli, atol=1e-5)
 
     def test_eevee(self):
-        folder = self.folder("eevee")
-        blend = self.blender.build_scene("eevee/scene", "--engine", "eevee",
-                                         "--output", os.path.join(folder, "out_####.exr"),
-                                         "--passes-dir", os.path.join(folder, "passes"))
-        self.render_frame(blend, folder)
-        ao, passes = self.assert_composite_is_beauty_times_ao(
-            os.path.join(folder, "out_0001.exr"), os.path.join(folder, "passes", "0001.exr"))
+        folder, ao, passes = self.render_scene("eevee", "--engine", "eevee")
         depth = passes["Depth.V"]
         # EEVEE's sky: 65504 (the largest half float) in Blender 3.x, the clip end in 4.2+.
         with open(os.path.join(folder, "scene.camera.json")) as f:
