@@ -10,6 +10,8 @@ PACKAGES=(
   libopenexr-dev nlohmann-json3-dev
   python3-numpy python3-openimageio         # Python test helpers (/usr/bin/python3)
   blender                                   # ground truth renders (Cycles AO pass)
+  povray povray-examples                    # the POV-Ray bridge and its test scenes
+  debootstrap                               # Blender 4.3 tests (a Debian 13 folder)
 )
 
 missing=()
