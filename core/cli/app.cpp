@@ -82,31 +82,6 @@ ssao_io::Camera load_camera(const Options& options) {
   return camera;
 }
 
-// Applied after the camera file, so a camera flag overrides the file. A value the core rejects
-// (out of range) is a command-line error.
-void apply_command_line_params(ssao_io::Job& job, const std::vector<ParamSetting>& params) {
-  for (const ParamSetting& setting : params) {
-    try {
-      switch (setting.type) {
-        case SSAO_PARAM_INT:
-          job.set(setting.name, setting.int_value);
-          break;
-        case SSAO_PARAM_FLOAT:
-          job.set(setting.name, setting.float_value);
-          break;
-        case SSAO_PARAM_STRING:
-          job.set(setting.name, setting.string_value);
-          break;
-        case SSAO_PARAM_FLOATS:
-          job.set(setting.name, setting.float_values);
-          break;
-      }
-    } catch (const ssao_io::CoreError&) {
-      throw UsageError(setting.flag + " " + setting.text + ": " + ssao_last_error());
-    }
-  }
-}
-
 std::vector<int> channel_indices(const ssao_io::Image& image, const std::vector<std::string>& names,
                                  const std::string& path) {
   std::vector<int> indices;
@@ -236,7 +211,7 @@ void run_ssao(const Options& options) {
 
   ssao_io::Job job;
   ssao_io::apply_camera(job.get(), camera, options.camera);
-  apply_command_line_params(job, options.params);
+  ssao_io::apply_params(job, options.params);  // after the camera: a flag overrides the file
 
   Inputs in = load_inputs(options);
   Outputs out;

@@ -1,29 +1,18 @@
 // SPDX-License-Identifier: MIT
 #include "args.h"
 
-#include <algorithm>
-#include <cerrno>
-#include <climits>
-#include <cmath>
-#include <cstdio>
-#include <cstdlib>
-#include <cstring>
+#include <string>
+#include <vector>
 
 #include "io/camera_json.h"
 
 namespace ssao_cli {
 namespace {
 
-std::vector<std::string> split(const std::string& text, char separator) {
-  std::vector<std::string> parts;
-  size_t start = 0;
-  while (true) {
-    const size_t end = text.find(separator, start);
-    parts.push_back(text.substr(start, end == std::string::npos ? std::string::npos : end - start));
-    if (end == std::string::npos) return parts;
-    start = end + 1;
-  }
-}
+using ssao_io::find_param;
+using ssao_io::help_entry;
+using ssao_io::parse_param;
+using ssao_io::split;
 
 std::vector<std::string> parse_channel_list(const std::string& flag, const std::string& text,
                                             size_t min_count, size_t max_count) {
@@ -95,124 +84,9 @@ const std::vector<FrontOption>& front_options() {
   return options;
 }
 
-// Integers as integers (2147483647, not 2.14748e+09), other numbers in %g.
-std::string format_number(double value, bool integer) {
-  if (std::isinf(value)) return value > 0 ? "inf" : "-inf";
-  char buffer[64];
-  if (integer || (value == std::floor(value) && std::fabs(value) < 1e6)) {
-    std::snprintf(buffer, sizeof buffer, "%.0f", value);
-  } else {
-    std::snprintf(buffer, sizeof buffer, "%g", value);
-  }
-  return buffer;
-}
-
-int parse_int(const std::string& flag, const std::string& text) {
-  errno = 0;
-  char* end = nullptr;
-  const long value = std::strtol(text.c_str(), &end, 10);
-  if (text.empty() || std::isspace(static_cast<unsigned char>(text[0])) || *end != '\0') {
-    throw UsageError(flag + " expects an integer, got '" + text + "'");
-  }
-  if (errno == ERANGE || value < INT_MIN || value > INT_MAX) {
-    throw UsageError(flag + ": integer out of range: '" + text + "'");
-  }
-  return static_cast<int>(value);
-}
-
-double parse_float(const std::string& flag, const std::string& text) {
-  errno = 0;
-  char* end = nullptr;
-  const double value = std::strtod(text.c_str(), &end);
-  if (text.empty() || std::isspace(static_cast<unsigned char>(text[0])) || *end != '\0') {
-    throw UsageError(flag + " expects a number, got '" + text + "'");
-  }
-  if (!std::isfinite(value))
-    throw UsageError(flag + " expects a finite number, got '" + text + "'");
-  return value;
-}
-
-ParamSetting parse_param(const ssao_param_desc& desc, const std::string& flag,
-                         const std::string& text) {
-  ParamSetting setting;
-  setting.name = desc.name;
-  setting.flag = flag;
-  setting.text = text;
-  setting.type = desc.type;
-  switch (desc.type) {
-    case SSAO_PARAM_INT:
-      setting.int_value = parse_int(flag, text);
-      break;
-    case SSAO_PARAM_FLOAT:
-      setting.float_value = parse_float(flag, text);
-      break;
-    case SSAO_PARAM_STRING: {
-      const std::vector<std::string> choices = split(desc.choices ? desc.choices : "", '|');
-      if (std::find(choices.begin(), choices.end(), text) == choices.end()) {
-        throw UsageError(flag + " must be one of " + (desc.choices ? desc.choices : "") +
-                         ", got '" + text + "'");
-      }
-      setting.string_value = text;
-      break;
-    }
-    case SSAO_PARAM_FLOATS: {
-      const std::vector<std::string> parts = split(text, ',');
-      if (parts.size() != desc.count) {
-        throw UsageError(flag + " expects " + std::to_string(desc.count) +
-                         " comma-separated numbers, got " + std::to_string(parts.size()));
-      }
-      for (const std::string& part : parts) setting.float_values.push_back(parse_float(flag, part));
-      break;
-    }
-  }
-  return setting;
-}
-
-size_t edit_distance(const std::string& a, const std::string& b) {
-  std::vector<size_t> row(b.size() + 1);
-  for (size_t j = 0; j <= b.size(); ++j) row[j] = j;
-  for (size_t i = 1; i <= a.size(); ++i) {
-    size_t diagonal = row[0];
-    row[0] = i;
-    for (size_t j = 1; j <= b.size(); ++j) {
-      const size_t up = row[j];
-      row[j] = std::min({row[j] + 1, row[j - 1] + 1, diagonal + (a[i - 1] == b[j - 1] ? 0 : 1)});
-      diagonal = up;
-    }
-  }
-  return row[b.size()];
-}
-
-std::string unknown_option_message(const std::string& flag,
-                                   const std::vector<ssao_param_desc>& table) {
-  std::vector<std::string> known;
-  for (const FrontOption& option : front_options()) known.push_back(option.flag);
-  for (const ssao_param_desc& desc : table) known.push_back(flag_for(desc.name));
-  std::string best;
-  size_t best_distance = 3;  // suggest only close matches
-  for (const std::string& candidate : known) {
-    const size_t distance = edit_distance(flag, candidate);
-    if (distance < best_distance) {
-      best_distance = distance;
-      best = candidate;
-    }
-  }
-  std::string message = "unknown option '" + flag + "'";
-  if (!best.empty()) message += " (did you mean " + best + "?)";
-  return message;
-}
-
 const FrontOption* find_front_option(const std::string& flag) {
   for (const FrontOption& option : front_options()) {
     if (flag == option.flag || (option.alias && flag == option.alias)) return &option;
-  }
-  return nullptr;
-}
-
-const ssao_param_desc* find_param(const std::string& flag,
-                                  const std::vector<ssao_param_desc>& table) {
-  for (const ssao_param_desc& desc : table) {
-    if (flag == flag_for(desc.name)) return &desc;
   }
   return nullptr;
 }
@@ -226,91 +100,15 @@ void require_complete(const Options& options) {
   }
 }
 
-// Word-wraps `text` to `width` columns, every line but the first indented by `indent`.
-std::string wrap(const std::string& text, size_t indent, size_t width) {
-  std::string out;
-  size_t column = indent;
-  for (const std::string& word : split(text, ' ')) {
-    if (word.empty()) continue;
-    if (column > indent && column + 1 + word.size() > width) {
-      out += "\n" + std::string(indent, ' ');
-      column = indent;
-    } else if (column > indent) {
-      out += ' ';
-      ++column;
-    }
-    out += word;
-    column += word.size();
-  }
-  return out;
-}
-
-constexpr size_t kHelpColumn = 30;
-constexpr size_t kHelpWidth = 100;
-
-std::string help_entry(const std::string& left, const std::string& text) {
-  std::string line = "  " + left;
-  if (line.size() + 2 > kHelpColumn) {
-    line += "\n" + std::string(kHelpColumn, ' ');
-  } else {
-    line += std::string(kHelpColumn - line.size(), ' ');
-  }
-  return line + wrap(text, kHelpColumn, kHelpWidth) + "\n";
-}
-
-std::string param_metavar(const ssao_param_desc& desc) {
-  switch (desc.type) {
-    case SSAO_PARAM_INT:
-      return "N";
-    case SSAO_PARAM_FLOAT:
-      return "X";
-    case SSAO_PARAM_STRING:
-      return desc.choices ? desc.choices : "S";
-    case SSAO_PARAM_FLOATS:
-      return "X1,...,X" + std::to_string(desc.count);
-  }
-  return "VALUE";
-}
-
-std::string param_facts(const ssao_param_desc& desc) {
-  std::string facts;
-  const std::string unit = desc.unit ? desc.unit : "";
-  const bool integer = desc.type == SSAO_PARAM_INT;
-  switch (desc.type) {
-    case SSAO_PARAM_INT:
-    case SSAO_PARAM_FLOAT:
-      facts = "default " + format_number(desc.default_value, integer);
-      if (!unit.empty()) facts += " (" + unit + ")";
-      if (std::isinf(desc.max_value)) {
-        facts += ", range >= " + format_number(desc.min_value, integer);
-      } else {
-        facts += ", range " + format_number(desc.min_value, integer) + ".." +
-                 format_number(desc.max_value, integer);
-      }
-      break;
-    case SSAO_PARAM_STRING:
-      facts = std::string("default ") + (desc.default_string ? desc.default_string : "");
-      break;
-    case SSAO_PARAM_FLOATS:
-      facts = std::to_string(desc.count) + " values";
-      if (!unit.empty()) facts += " (" + unit + ")";
-      break;
-  }
-  return facts;
-}
-
-bool is_camera_param(const char* name) {
-  const auto& names = ssao_io::camera_param_names();
-  return std::find(names.begin(), names.end(), name) != names.end();
+std::string unknown_option_message(const std::string& flag,
+                                   const std::vector<ssao_param_desc>& table) {
+  std::vector<std::string> known;
+  for (const FrontOption& option : front_options()) known.push_back(option.flag);
+  for (const ssao_param_desc& desc : table) known.push_back(flag_for(desc.name));
+  return ssao_io::unknown_option_message(flag, known);
 }
 
 }  // namespace
-
-std::string flag_for(const std::string& param_name) {
-  std::string flag = "--" + param_name;
-  std::replace(flag.begin(), flag.end(), '_', '-');
-  return flag;
-}
 
 Options parse_args(int argc, const char* const* argv, const std::vector<ssao_param_desc>& table) {
   Options out;
@@ -403,12 +201,9 @@ std::string usage_text(const std::vector<ssao_param_desc>& table) {
 
   auto param_section = [&](const char* title, bool camera) {
     text += std::string("\n") + title + "\n";
-    for (const ssao_param_desc& desc : table) {
-      if (is_camera_param(desc.name) != camera) continue;
-      const std::string description = desc.description ? desc.description : "";
-      text += help_entry(flag_for(desc.name) + " " + param_metavar(desc),
-                         description + " [" + param_facts(desc) + "]");
-    }
+    text += ssao_io::param_help(table, [camera](const ssao_param_desc& desc) {
+      return ssao_io::is_camera_param(desc.name) == camera;
+    });
   };
   param_section(
       "AO parameters (libssao's parameter table; --NAME_WITH_UNDERSCORES is written "

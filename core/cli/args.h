@@ -4,31 +4,19 @@
 // parsed according to its type, and --help prints the table.
 #pragma once
 
-#include <stdexcept>
 #include <string>
 #include <vector>
 
+#include "io/param_flags.h"
 #include "ssao/ssao.h"
 
 namespace ssao_cli {
 
-// A wrong command line: reported with a hint to --help, exit status 2.
-class UsageError : public std::runtime_error {
- public:
-  explicit UsageError(const std::string& message) : std::runtime_error(message) {}
-};
-
-// One core parameter given on the command line, already parsed to its type.
-struct ParamSetting {
-  std::string name;  // the core's name, with underscores
-  std::string flag;  // as written, e.g. "--sphere-mode"
-  std::string text;  // the value as written
-  ssao_param_type type = SSAO_PARAM_FLOAT;
-  int int_value = 0;
-  double float_value = 0.0;
-  std::string string_value;
-  std::vector<double> float_values;
-};
+// A wrong command line: reported with a hint to --help, exit status 2. The parameter flags
+// (--NAME-WITH-DASHES, parsing, help) are shared with the other front ends: io/param_flags.h.
+using ssao_io::flag_for;
+using ssao_io::ParamSetting;
+using ssao_io::UsageError;
 
 struct Options {
   bool help = false;
@@ -53,8 +41,5 @@ Options parse_args(int argc, const char* const* argv, const std::vector<ssao_par
 
 // The text --help prints, parameters (defaults, units, ranges, choices) taken from `table`.
 std::string usage_text(const std::vector<ssao_param_desc>& table);
-
-// "sphere_mode" -> "--sphere-mode".
-std::string flag_for(const std::string& param_name);
 
 }  // namespace ssao_cli

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: MIT
 #include "io/camera_json.h"
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -158,6 +159,11 @@ const std::vector<std::string>& camera_param_names() {
       "shift_x",        "shift_y",        "ortho_scale",    "clip_start",    "clip_end",
       "pixel_aspect_x", "pixel_aspect_y", "camera_to_world"};
   return names;
+}
+
+bool is_camera_param(const std::string& name) {
+  const auto& names = camera_param_names();
+  return std::find(names.begin(), names.end(), name) != names.end();
 }
 
 void apply_camera(ssao_job job, const Camera& camera, const std::string& source) {

@@ -49,6 +49,9 @@ Camera parse_camera_json(const std::string& text, const std::string& source);
 // pixel_aspect_y, camera_to_world.
 const std::vector<std::string>& camera_param_names();
 
+// True if `name` is one of camera_param_names().
+bool is_camera_param(const std::string& name);
+
 // Sets the camera parameters of `job` through the C API. `source` (the file name) prefixes the
 // messages. Throws Error with ssao_last_error() when the core rejects a value.
 void apply_camera(ssao_job job, const Camera& camera, const std::string& source);

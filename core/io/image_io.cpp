@@ -148,6 +148,7 @@ Image read_image(const std::string& path) {
   Image image;
   image.width = spec.width;
   image.height = spec.height;
+  image.color_space = spec.get_string_attribute("oiio:ColorSpace");
   const size_t count = checked_float_count(spec.width, spec.height, spec.nchannels, path);
   for (int c = 0; c < spec.nchannels; ++c) image.channel_names.push_back(spec.channel_name(c));
   try {
@@ -166,6 +167,38 @@ Image read_image(const std::string& path) {
                 oiio_detail(error) + ")");
   }
   return image;
+}
+
+bool linearize(Image& image) {
+  const std::string& space = image.color_space;
+  double gamma = 0.0;  // 0: the sRGB curve
+  if (space == "sRGB") {
+    gamma = 0.0;
+  } else if (space.rfind("GammaCorrected", 0) == 0 || space.rfind("Gamma", 0) == 0) {
+    const std::string value = space.substr(space.rfind("GammaCorrected", 0) == 0 ? 14 : 5);
+    gamma = std::strtod(value.c_str(), nullptr);
+    if (!(gamma > 0.0) || gamma == 1.0) return false;
+  } else {
+    return false;
+  }
+  const size_t channels = static_cast<size_t>(image.channels());
+  std::vector<bool> colour(channels);
+  for (size_t c = 0; c < channels; ++c) {
+    const std::string& name = image.channel_names[c];
+    colour[c] = name != "A" && name != "Alpha" && name != "alpha";
+  }
+  for (size_t i = 0; i < image.pixels.size(); ++i) {
+    if (!colour[i % channels]) continue;
+    const float v = image.pixels[i];
+    if (gamma > 0.0) {
+      image.pixels[i] = v > 0.0f ? static_cast<float>(std::pow(v, gamma)) : v;
+    } else {
+      image.pixels[i] =
+          v <= 0.04045f ? v / 12.92f : std::pow((v + 0.055f) / 1.055f, 2.4f);  // IEC 61966-2-1
+    }
+  }
+  image.color_space = "Linear";
+  return true;
 }
 
 int require_channel(const Image& image, const std::string& name, const std::string& path) {

@@ -18,6 +18,10 @@ struct Image {
   int height = 0;
   std::vector<std::string> channel_names;
   std::vector<float> pixels;
+  // How the file encodes its values, as OpenImageIO reports it ("oiio:ColorSpace": "Linear",
+  // "sRGB", "GammaCorrected2.2", ...; "" if the file does not say). read_image() returns the
+  // stored values as they are (an 8-bit sRGB PNG reads as its code values / 255).
+  std::string color_space;
 
   int channels() const { return static_cast<int>(channel_names.size()); }
   size_t pixel_count() const { return static_cast<size_t>(width) * static_cast<size_t>(height); }
@@ -30,6 +34,12 @@ struct Image {
 // that is not an image OIIO can read, a truncated or corrupt file (OIIO's message included), a
 // deep image, or a data window that differs from the display window.
 Image read_image(const std::string& path);
+
+// Converts the stored values of an image read from an sRGB- or gamma-encoded file
+// (color_space "sRGB", "GammaCorrected<g>" or "Gamma<g>", e.g. an 8-bit PNG) to linear light,
+// every channel except alpha ("A", "Alpha"); other images are left as they are. Returns true if
+// it converted anything.
+bool linearize(Image& image);
 
 // Index of channel `name` in `image` (read from `path`, used in the message); throws Error
 // listing the channels that do exist when there is none.

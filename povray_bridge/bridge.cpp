@@ -1,0 +1,766 @@
+// SPDX-License-Identifier: MIT
+#include "bridge.h"
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdarg>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "io/image_io.h"
+#include "io/job.h"
+#include "io/param_flags.h"
+#include "passes.h"
+#include "pov_camera.h"
+#include "povray_run.h"
+#include "sdl.h"
+
+#ifndef POVRAY_SSAO_SOURCE_INCLUDES
+#define POVRAY_SSAO_SOURCE_INCLUDES ""
+#endif
+
+namespace povray_ssao {
+namespace {
+
+namespace fs = std::filesystem;
+using Clock = std::chrono::steady_clock;
+
+constexpr float kInfinity = std::numeric_limits<float>::infinity();
+
+// Progress on stdout, warnings on stderr; both silenced by --quiet.
+class Reporter {
+ public:
+  explicit Reporter(bool quiet) : quiet_(quiet) {}
+  ~Reporter() {
+    if (open_) std::fputs("failed\n", stdout);  // a step ended by an exception
+    std::fflush(stdout);
+  }
+  Reporter(const Reporter&) = delete;
+  Reporter& operator=(const Reporter&) = delete;
+  void progress(const char* format, ...) const __attribute__((format(printf, 2, 3))) {
+    if (quiet_) return;
+    if (open_) std::fputs("failed\n", stdout);
+    open_ = false;
+    std::va_list args;
+    va_start(args, format);
+    std::fputs("povray-ssao: ", stdout);
+    std::vfprintf(stdout, format, args);
+    std::fputc('\n', stdout);
+    std::fflush(stdout);
+    va_end(args);
+  }
+  // Continues a progress line started with begin() ("...") with its result.
+  void begin(const char* format, ...) const __attribute__((format(printf, 2, 3))) {
+    if (quiet_) return;
+    std::va_list args;
+    va_start(args, format);
+    std::fputs("povray-ssao: ", stdout);
+    std::vfprintf(stdout, format, args);
+    std::fflush(stdout);
+    va_end(args);
+    open_ = true;
+  }
+  void end(const char* format, ...) const __attribute__((format(printf, 2, 3))) {
+    if (quiet_) return;
+    std::va_list args;
+    va_start(args, format);
+    std::vfprintf(stdout, format, args);
+    std::fputc('\n', stdout);
+    std::fflush(stdout);
+    va_end(args);
+    open_ = false;
+  }
+  void warning(const std::string& message) const {
+    if (quiet_) return;
+    if (open_) std::fputs("failed\n", stdout);
+    open_ = false;
+    std::fflush(stdout);
+    std::fprintf(stderr, "povray-ssao: warning: %s\n", message.c_str());
+  }
+
+ private:
+  bool quiet_;
+  mutable bool open_ = false;  // a begin() line waits for its end()
+};
+
+std::string in_quotes(const std::string& path) { return "'" + path + "'"; }
+
+// Fails before any work when an output cannot be created.
+void check_output_folder(const std::string& path) {
+  fs::path folder = fs::path(path).parent_path();
+  if (folder.empty()) folder = ".";
+  std::error_code ec;
+  if (!fs::is_directory(folder, ec)) {
+    throw ssao_io::Error("cannot write " + in_quotes(path) + ": no folder " +
+                         in_quotes(folder.string()));
+  }
+  if (::access(folder.c_str(), W_OK) != 0) {
+    throw ssao_io::Error("cannot write " + in_quotes(path) + ": folder " +
+                         in_quotes(folder.string()) + " is not writable");
+  }
+  if (fs::is_directory(path, ec)) {
+    throw ssao_io::Error("cannot write " + in_quotes(path) + ": it is a directory");
+  }
+}
+
+bool same_file(const std::string& a, const std::string& b) {
+  std::error_code ec;
+  if (fs::exists(a, ec) && fs::exists(b, ec)) return fs::equivalent(a, b, ec);
+  return fs::weakly_canonical(a, ec) == fs::weakly_canonical(b, ec);
+}
+
+// The folder of the shipped includes: next to the binary (<bin>/../share/povray-ssao), else
+// the source tree's povray_bridge/pov.
+std::string include_folder() {
+  std::vector<fs::path> candidates;
+  std::error_code ec;
+  const fs::path self = fs::read_symlink("/proc/self/exe", ec);
+  if (!ec) candidates.push_back(self.parent_path().parent_path() / "share" / "povray-ssao");
+  if (*POVRAY_SSAO_SOURCE_INCLUDES) candidates.emplace_back(POVRAY_SSAO_SOURCE_INCLUDES);
+  std::string tried;
+  for (const fs::path& candidate : candidates) {
+    if (fs::is_regular_file(candidate / "ssao_depth_post.inc", ec) &&
+        fs::is_regular_file(candidate / "ssao_depth_pre.inc", ec)) {
+      return fs::absolute(candidate).lexically_normal().string();
+    }
+    tried += (tried.empty() ? "" : ", ") + in_quotes(candidate.string());
+  }
+  throw ssao_io::Error(
+      "cannot find povray-ssao's include files ssao_depth_pre.inc and "
+      "ssao_depth_post.inc (looked in " +
+      tried + ")");
+}
+
+// "D1 = 25.2, D2 = 252"
+std::string describe(const FogDistances& d) {
+  char buffer[128];
+  std::snprintf(buffer, sizeof buffer, "D1 = %.4g, D2 = %.4g", d.d1, d.d2);
+  std::string out = buffer;
+  if (d.d3 > 0.0) {
+    std::snprintf(buffer, sizeof buffer, ", D3 = %.4g", d.d3);
+    out += buffer;
+  }
+  return out;
+}
+
+double seconds_since(Clock::time_point start) {
+  return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+// Everything the AO step needs, whichever mode produced it.
+struct AoInputs {
+  int width = 0, height = 0;
+  std::vector<float> beauty;  // R, G, B, A (linear; A = 1 when the beauty has none)
+  bool beauty_has_alpha = false;
+  std::vector<float> radial;   // distance from the camera; +inf on background
+  std::vector<float> planar;   // along the view axis; +inf on background
+  std::vector<float> normals;  // libssao camera space, 3 per pixel, or empty
+  bool planar_input = false;   // give libssao the planar depth (orthographic, planar files)
+  ResolvedCamera camera;
+};
+
+// Copies the channels R, G, B (and A) of `image` into RGBA; a grey image (Y or one channel)
+// gives R = G = B.
+void take_beauty(const ssao_io::Image& image, const std::string& path, AoInputs& in) {
+  int rgb[3] = {image.find_channel("R"), image.find_channel("G"), image.find_channel("B")};
+  if (rgb[0] < 0 || rgb[1] < 0 || rgb[2] < 0) {
+    int grey = image.find_channel("Y");
+    if (grey < 0 && image.channels() <= 2) grey = 0;
+    if (grey < 0) {
+      throw ssao_io::Error(in_quotes(path) + " has no R, G, B channels; its channels are: " +
+                           ssao_io::join_names(image.channel_names));
+    }
+    rgb[0] = rgb[1] = rgb[2] = grey;
+  }
+  const int alpha = image.find_channel("A");
+  in.beauty_has_alpha = alpha >= 0;
+  const size_t stride = static_cast<size_t>(image.channels());
+  in.beauty.assign(image.pixel_count() * 4, 1.0f);
+  for (size_t p = 0; p < image.pixel_count(); ++p) {
+    for (int c = 0; c < 3; ++c) {
+      in.beauty[p * 4 + static_cast<size_t>(c)] =
+          image.pixels[p * stride + static_cast<size_t>(rgb[c])];
+    }
+    if (alpha >= 0) in.beauty[p * 4 + 3] = image.pixels[p * stride + static_cast<size_t>(alpha)];
+  }
+}
+
+void fill_planar_and_radial(AoInputs& in, const std::vector<float>& depth, bool depth_is_planar) {
+  const size_t count = static_cast<size_t>(in.width) * static_cast<size_t>(in.height);
+  in.radial.assign(count, kInfinity);
+  in.planar.assign(count, kInfinity);
+  for (int y = 0; y < in.height; ++y) {
+    for (int x = 0; x < in.width; ++x) {
+      const size_t p =
+          static_cast<size_t>(y) * static_cast<size_t>(in.width) + static_cast<size_t>(x);
+      const float d = depth[p];
+      if (!(std::isfinite(d) && d > 0.0f)) continue;
+      const double factor = in.camera.radial_factor(x, y, in.width, in.height);
+      if (depth_is_planar) {
+        in.planar[p] = d;
+        in.radial[p] = static_cast<float>(d * factor);
+      } else {
+        in.radial[p] = d;
+        in.planar[p] = static_cast<float>(d / factor);
+      }
+    }
+  }
+}
+
+std::vector<std::string> full_channel_names() { return {"R", "G", "B", "A", "AO", "Z", "Radial"}; }
+
+// Writes -o (and --exr): an 8-bit sRGB preview of the composite, or every channel as float EXR.
+// If the second file cannot be written the first is removed again.
+void write_outputs(const Options& o, const AoInputs& in, const std::vector<float>& composite,
+                   const std::vector<float>& ao) {
+  const size_t count = static_cast<size_t>(in.width) * static_cast<size_t>(in.height);
+  std::vector<float> full(count * 7);
+  for (size_t p = 0; p < count; ++p) {
+    for (size_t c = 0; c < 4; ++c) full[p * 7 + c] = composite[p * 4 + c];
+    full[p * 7 + 4] = ao[p];
+    full[p * 7 + 5] = in.planar[p];
+    full[p * 7 + 6] = in.radial[p];
+  }
+  auto write_main = [&]() {
+    if (!ssao_io::is_preview_path(o.output)) {
+      ssao_io::write_exr(o.output, in.width, in.height, full_channel_names(), full);
+      return;
+    }
+    const size_t channels = in.beauty_has_alpha ? 4 : 3;
+    std::vector<float> preview(count * channels);
+    for (size_t p = 0; p < count; ++p) {
+      for (size_t c = 0; c < channels; ++c) preview[p * channels + c] = composite[p * 4 + c];
+    }
+    std::vector<std::string> names = {"R", "G", "B", "A"};
+    names.resize(channels);
+    ssao_io::write_preview(o.output, in.width, in.height, names, preview);
+  };
+  if (o.exr.empty()) {
+    write_main();
+    return;
+  }
+  ssao_io::write_exr(o.exr, in.width, in.height, full_channel_names(), full);
+  try {
+    write_main();
+  } catch (...) {
+    std::error_code ec;
+    fs::remove(o.exr, ec);
+    throw;
+  }
+}
+
+int progress_callback(void*, double) { return InterruptGuard::interrupted() ? 0 : 1; }
+
+// Runs libssao and writes the outputs; returns the seconds spent in ssao_job_run.
+double compute_and_write(const Options& o, AoInputs& in, const Reporter& report) {
+  ssao_io::Job job;
+  in.camera.apply_to_job(job, in.width, in.height);
+  job.set("depth_kind", in.planar_input ? "planar" : "radial");
+  if (!in.normals.empty()) job.set("normal_space", "camera");
+  ssao_io::apply_params(job, o.params);
+
+  if (!o.param("radius")) {
+    double radius = 0.0;
+    std::string rule;
+    if (in.camera.orthographic) {
+      radius = 0.05 * length(in.camera.right);
+      rule = "5% of the view width " + std::to_string(length(in.camera.right));
+    } else {
+      const DepthStats stats = depth_stats(in.radial);
+      if (stats.geometry > 0) {
+        radius = 0.05 * stats.median;
+        char buffer[64];
+        std::snprintf(buffer, sizeof buffer, "%.6g", stats.median);
+        rule = std::string("5% of the median depth ") + buffer;
+      }
+    }
+    if (radius > 0.0) {
+      job.set("radius", radius);
+      report.progress("radius %.6g scene units (%s; --radius to change)", radius, rule.c_str());
+    }
+  }
+
+  const size_t count = static_cast<size_t>(in.width) * static_cast<size_t>(in.height);
+  std::vector<float> ao(count, 1.0f);
+  std::vector<float> composite(count * 4, 0.0f);
+  std::vector<float>& depth = in.planar_input ? in.planar : in.radial;
+  job.set_image("depth", depth.data(), in.width, in.height, 1);
+  if (!in.normals.empty()) job.set_image("normal", in.normals.data(), in.width, in.height, 3);
+  job.set_image("beauty", in.beauty.data(), in.width, in.height, 4);
+  job.set_image("composite", composite.data(), in.width, in.height, 4);
+  job.set_image("ao", ao.data(), in.width, in.height, 1);
+  job.set_progress(&progress_callback, nullptr);
+
+  report.begin("AO (%s, %d samples, normals %s)... ", job.get_string("variant").c_str(),
+               job.get_int("samples"), in.normals.empty() ? "from depth" : "from the normal pass");
+  const auto start = Clock::now();
+  const ssao_status status = ssao_job_run(job.get());
+  const double seconds = seconds_since(start);
+  if (status == SSAO_ERROR_CANCELLED || InterruptGuard::interrupted()) {
+    report.end("interrupted");
+    throw ssao_io::Error("interrupted; nothing written");
+  }
+  ssao_io::check_status(status, "SSAO failed");
+  double sum = 0.0;
+  size_t geometry = 0;
+  for (size_t p = 0; p < count; ++p) {
+    if (!std::isfinite(depth[p])) continue;
+    sum += ao[p];
+    ++geometry;
+  }
+  report.end("%.2f s, mean AO %.3f over %zu geometry pixels", seconds,
+             geometry ? sum / static_cast<double>(geometry) : 1.0, geometry);
+  write_outputs(o, in, composite, ao);
+  return seconds;
+}
+
+// One povray run in the scene's folder with povray-ssao's includes on the library path.
+struct Povray {
+  std::string executable;
+  std::string scene_folder;
+  std::string include_folder;
+  std::vector<std::string> user_options;  // --ini and the pass-through options, in order
+  const ScratchFolder* scratch = nullptr;
+  bool keep = false;
+
+  double render(const std::string& what, const std::string& name, const std::string& wrapper,
+                int width, int height, const std::vector<std::string>& extra) const {
+    const std::string output = scratch->file(name + ".exr");
+    const std::string log = scratch->file(name + ".log");
+    std::vector<std::string> args = user_options;
+    args.push_back("+I" + scratch->file(wrapper));
+    args.push_back("+O" + output);
+    args.push_back("+W" + std::to_string(width));
+    args.push_back("+H" + std::to_string(height));
+    args.push_back("-D");
+    args.push_back("-P");
+    args.push_back("+FE");
+    args.push_back("+L" + scene_folder);
+    args.push_back("+L" + include_folder);
+    args.insert(args.end(), extra.begin(), extra.end());
+    {
+      FILE* file = std::fopen(log.c_str(), "w");
+      if (file) {
+        std::fprintf(file, "povray-ssao: %s", executable.c_str());
+        for (const std::string& arg : args) std::fprintf(file, " %s", arg.c_str());
+        std::fprintf(file, "\n(in %s)\n\n", scene_folder.c_str());
+        std::fclose(file);
+      }
+    }
+    const RenderResult result = run_process(executable, args, scene_folder, log);
+    std::error_code ec;
+    if (result.exit_status != 0 || !fs::is_regular_file(output, ec)) {
+      std::string message = "POV-Ray failed on the " + what;
+      message += result.exit_status != 0
+                     ? " (exit status " + std::to_string(result.exit_status) + ")"
+                     : " (no image written)";
+      message += ". Its last messages:\n" + povray_error_lines(log);
+      if (!keep) message += "(--keep DIR keeps the wrappers and the full logs)";
+      while (!message.empty() && message.back() == '\n') message.pop_back();
+      throw ssao_io::Error(message);
+    }
+    return result.seconds;
+  }
+};
+
+// Copies the scratch folder's files to --keep DIR when it goes out of scope (also on failure).
+class KeepFiles {
+ public:
+  KeepFiles(const ScratchFolder& scratch, std::string target, const Reporter& report)
+      : scratch_(scratch), target_(std::move(target)), report_(report) {}
+  ~KeepFiles() {
+    if (target_.empty()) return;
+    std::error_code ec;
+    for (const auto& entry : fs::directory_iterator(scratch_.path(), ec)) {
+      fs::copy_file(entry.path(), fs::path(target_) / entry.path().filename(),
+                    fs::copy_options::overwrite_existing, ec);
+      if (ec) {
+        report_.warning("--keep: cannot copy " + entry.path().filename().string() + " to " +
+                        in_quotes(target_) + ": " + ec.message());
+        return;
+      }
+    }
+    report_.progress("kept the wrappers, logs and passes in %s", target_.c_str());
+  }
+  KeepFiles(const KeepFiles&) = delete;
+  KeepFiles& operator=(const KeepFiles&) = delete;
+
+ private:
+  const ScratchFolder& scratch_;
+  std::string target_;
+  const Reporter& report_;
+};
+
+void print_camera(const CameraReading& reading, int width, int height) {
+  std::printf("camera: %s\n  read from %s\n", reading.camera.summary().c_str(),
+              reading.source.c_str());
+  std::printf("every pass is rendered with (after the scene):\n%s",
+              reading.camera.to_sdl().c_str());
+  ssao_io::Job job;
+  reading.camera.apply_to_job(job, width, height);
+  if (reading.camera.orthographic) {
+    std::printf("libssao (%dx%d): camera_type ORTHO, ortho_scale %.9g", width, height,
+                job.get_float("ortho_scale"));
+  } else {
+    std::printf("libssao (%dx%d): camera_type PERSP, lens %.9g mm, sensor_width 36 mm", width,
+                height, job.get_float("lens"));
+  }
+  std::printf(", sensor_fit HORIZONTAL, pixel_aspect %.9g:%.9g\n", job.get_float("pixel_aspect_x"),
+              job.get_float("pixel_aspect_y"));
+}
+
+}  // namespace
+
+void run_render(const Options& o) {
+  InterruptGuard interrupt_guard;
+  const Reporter report(o.quiet);
+  const auto start = Clock::now();
+
+  // Everything that can be checked before POV-Ray runs.
+  std::error_code ec;
+  if (!fs::exists(o.scene, ec)) throw ssao_io::Error("no scene file " + in_quotes(o.scene));
+  if (!fs::is_regular_file(o.scene, ec)) {
+    throw ssao_io::Error("the scene " + in_quotes(o.scene) + " is not a file");
+  }
+  if (::access(o.scene.c_str(), R_OK) != 0) {
+    throw ssao_io::Error("cannot read the scene file " + in_quotes(o.scene));
+  }
+  const fs::path scene_path = fs::absolute(o.scene).lexically_normal();
+  const std::string scene_folder = scene_path.parent_path().string();
+  const std::string scene_name = scene_path.filename().string();
+  if (scene_name.find('"') != std::string::npos) {
+    throw ssao_io::Error(
+        "the scene's file name contains '\"', which POV-Ray's #include cannot "
+        "take");
+  }
+  if (!o.print_camera) {
+    check_output_folder(o.output);
+    if (!o.exr.empty()) check_output_folder(o.exr);
+    if (same_file(o.output, o.scene) || (!o.exr.empty() && same_file(o.exr, o.scene))) {
+      throw UsageError("the output is the scene file; choose another -o");
+    }
+  }
+  if (!o.ini.empty() && !fs::is_regular_file(o.ini, ec)) {
+    throw ssao_io::Error("no INI file " + in_quotes(o.ini));
+  }
+  if (!o.keep.empty()) {
+    fs::create_directories(o.keep, ec);
+    if (!fs::is_directory(o.keep, ec)) {
+      throw ssao_io::Error("--keep: cannot create the folder " + in_quotes(o.keep));
+    }
+  }
+
+  int width = o.width, height = o.height;
+  if (!o.ini.empty() && (width == 0 || height == 0)) {
+    int w = 0, h = 0;
+    ini_size(o.ini, w, h);
+    if (width == 0) width = w;
+    if (height == 0) height = h;
+  }
+  default_size(scene_folder, width, height);
+
+  // The camera, from the scene text (and its include files, found as POV-Ray finds them).
+  const std::string includes = include_folder();
+  std::vector<std::string> library_paths;
+  const std::string startup_ini = system_ini(scene_folder);
+  if (!startup_ini.empty()) ini_library_paths(startup_ini, library_paths);
+  if (!o.ini.empty()) ini_library_paths(o.ini, library_paths);
+  for (const std::string& option : o.povray_options) {
+    if (option.size() > 2 && (option[1] == 'L' || option[1] == 'l')) {
+      library_paths.push_back(option.substr(2));
+    } else if (option.size() > 13 &&
+               (option.rfind("Library_Path=", 0) == 0 || option.rfind("library_path=", 0) == 0)) {
+      library_paths.push_back(option.substr(13));
+    }
+  }
+  library_paths.push_back(scene_folder);
+  library_paths.push_back(includes);
+  for (std::string& path : library_paths) {
+    if (fs::path(path).is_relative()) path = (fs::path(scene_folder) / path).string();
+  }
+  ScanSettings settings;
+  settings.directory = scene_folder;
+  settings.library_paths = library_paths;
+  settings.image_width = width;
+  settings.image_height = height;
+  std::vector<std::string> declares;
+  if (!startup_ini.empty()) ini_declares(startup_ini, declares, settings.clock);
+  if (!o.ini.empty()) ini_declares(o.ini, declares, settings.clock);
+  option_declares(o.povray_options, declares, settings.clock);
+  for (const std::string& declare : declares) {
+    // NAME=VALUE with a number (POV-Ray's Declare= takes floats only).
+    const size_t equals = declare.find('=');
+    Symbol symbol;
+    symbol.kind = Symbol::kValue;
+    symbol.declared_at = "Declare=" + declare;
+    char* end = nullptr;
+    symbol.value.v.x = std::strtod(declare.c_str() + equals + 1, &end);
+    if (equals != std::string::npos && end && *end == '\0') {
+      settings.predeclared[declare.substr(0, equals)] = symbol;
+    }
+  }
+  const SceneScan scan = scan_scene(scene_path.string(), settings);
+  const CameraReading reading = read_camera(scan, o.camera, width, height);
+  if (o.print_camera) {
+    for (const std::string& note : scan.notes) report.warning(note);
+    for (const std::string& warning : reading.warnings) report.warning(warning);
+    print_camera(reading, width, height);
+    return;
+  }
+  report.progress("camera: %s (%s)", reading.camera.summary().c_str(), reading.source.c_str());
+  for (const std::string& note : scan.notes) report.warning(note);
+  for (const std::string& warning : reading.warnings) report.warning(warning);
+  if (reading.had_focal_blur) {
+    report.warning(
+        "the scene's camera has focal blur (aperture); povray-ssao renders every "
+        "pass, the beauty included, without it (a blurred depth pass would be wrong, "
+        "and far slower)");
+  }
+  const double pixel_ratio =
+      reading.camera.aspect() / (static_cast<double>(width) / static_cast<double>(height));
+  if (std::fabs(pixel_ratio - 1.0) > 0.01) {
+    report.warning("the camera's |right|/|up| (" + std::to_string(reading.camera.aspect()) +
+                   ") differs from the image's width/height: non-square pixels, as POV-Ray "
+                   "renders them");
+  }
+
+  Povray povray;
+  povray.executable = find_executable(o.povray);
+  povray.scene_folder = scene_folder;
+  povray.include_folder = includes;
+  if (!o.ini.empty()) povray.user_options.push_back(fs::absolute(o.ini).string());
+  povray.user_options.insert(povray.user_options.end(), o.povray_options.begin(),
+                             o.povray_options.end());
+  ScratchFolder scratch;
+  povray.scratch = &scratch;
+  povray.keep = !o.keep.empty();
+  KeepFiles keep(scratch, o.keep, report);
+  write_wrappers(scratch.path(), scene_name, reading.camera);
+  const std::vector<std::string> data_pass = {"+Q9", "-A", "-UA"};
+
+  // 1. The pre-pass: the depth range, for the fog distances.
+  FogDistances distances;
+  double prepass_seconds = 0.0;
+  if (o.fog_distances) {
+    distances = *o.fog_distances;
+  } else {
+    const int pw = std::min(width, std::clamp(width / 8, 16, 80));
+    const int ph =
+        std::max(1, static_cast<int>(std::lround(static_cast<double>(pw) * height / width)));
+    report.begin("depth-range pre-pass (%dx%d)... ", pw, ph);
+    std::vector<std::string> extra = data_pass;
+    for (const std::string& d : fog_declares(prepass_distances())) extra.push_back(d);
+    prepass_seconds = povray.render("depth-range pre-pass", "prepass", "depth.pov", pw, ph, extra);
+    const ssao_io::Image image = ssao_io::read_image(scratch.file("prepass.exr"));
+    const DepthStats stats =
+        depth_stats(decode_fog(image, prepass_distances(), scratch.file("prepass.exr")));
+    distances = choose_distances(stats);
+    if (stats.geometry == 0) {
+      report.end("%.2f s", prepass_seconds);
+      report.warning(
+          "the pre-pass saw no geometry (every ray missed); fog distances "
+          "D1 = 10, D2 = 100");
+    } else {
+      report.end("%.2f s: depths %.4g .. %.4g, median %.4g, 99%% below %.4g -> %s", prepass_seconds,
+                 stats.min, stats.max, stats.median, stats.p99, describe(distances).c_str());
+    }
+  }
+
+  // 2. The beauty, with the user's settings.
+  AoInputs in;
+  in.width = width;
+  in.height = height;
+  in.camera = reading.camera;
+  double beauty_seconds = 0.0;
+  if (!o.depth_only) {
+    report.begin("rendering beauty (%dx%d)... ", width, height);
+    beauty_seconds = povray.render("beauty", "beauty", "beauty.pov", width, height, {});
+    report.end("%.2f s", beauty_seconds);
+    const ssao_io::Image beauty = ssao_io::read_image(scratch.file("beauty.exr"));
+    if (beauty.width != width || beauty.height != height) {
+      throw ssao_io::Error("POV-Ray rendered the beauty at " + std::to_string(beauty.width) + "x" +
+                           std::to_string(beauty.height) + " instead of " + std::to_string(width) +
+                           "x" + std::to_string(height) +
+                           " (partial render options in the INI file?)");
+    }
+    take_beauty(beauty, scratch.file("beauty.exr"), in);
+  }
+
+  // 3. The depth pass.
+  report.begin("depth pass (%dx%d, %s)... ", width, height, describe(distances).c_str());
+  std::vector<std::string> extra = data_pass;
+  for (const std::string& d : fog_declares(distances)) extra.push_back(d);
+  const double depth_seconds =
+      povray.render("depth pass", "depth", "depth.pov", width, height, extra);
+  if (beauty_seconds > 0.0) {
+    report.end("%.2f s (%.2f x the beauty)", depth_seconds, depth_seconds / beauty_seconds);
+  } else {
+    report.end("%.2f s", depth_seconds);
+  }
+  {
+    const ssao_io::Image image = ssao_io::read_image(scratch.file("depth.exr"));
+    if (image.width != width || image.height != height) {
+      throw ssao_io::Error("POV-Ray rendered the depth pass at " + std::to_string(image.width) +
+                           "x" + std::to_string(image.height) + " instead of " +
+                           std::to_string(width) + "x" + std::to_string(height));
+    }
+    std::vector<float> precision;
+    const std::vector<float> depth =
+        decode_fog(image, distances, scratch.file("depth.exr"), &precision);
+    const DepthStats stats = depth_stats(depth);
+    if (stats.geometry == 0) {
+      report.warning("the depth pass saw no geometry: AO is 1 everywhere");
+    } else {
+      std::vector<float> errors;
+      for (size_t p = 0; p < depth.size(); ++p) {
+        if (std::isfinite(depth[p])) errors.push_back(precision[p]);
+      }
+      const DepthStats e = depth_stats(errors);
+      report.progress(
+          "  depth %.4g .. %.4g (median %.4g) on %.1f%% of the pixels; estimated "
+          "error (half-float rounding%s): median %.1e, 99%% %.1e, max %.1e of the depth",
+          stats.min, stats.max, stats.median,
+          100.0 * static_cast<double>(stats.geometry) / static_cast<double>(stats.total),
+          distances.d3 > 0.0 ? "" : " + leaked colour", e.median, e.p99, e.max);
+    }
+    // Fog depth is radial for a perspective camera and planar for an orthographic one.
+    in.planar_input = reading.camera.orthographic;
+    fill_planar_and_radial(in, depth, reading.camera.orthographic);
+  }
+
+  if (o.depth_only) {
+    const size_t count = static_cast<size_t>(width) * static_cast<size_t>(height);
+    std::vector<float> pixels(count * 2);
+    for (size_t p = 0; p < count; ++p) {
+      pixels[p * 2] = in.planar[p];
+      pixels[p * 2 + 1] = in.radial[p];
+    }
+    ssao_io::write_exr(o.output, width, height, {"Z", "Radial"}, pixels);
+    report.progress("wrote %s (Z, Radial) in %.2f s: pre-pass %.2f s, depth %.2f s",
+                    o.output.c_str(), seconds_since(start), prepass_seconds, depth_seconds);
+    return;
+  }
+
+  // 4. The exact normals of scenes that opt in.
+  double normal_seconds = 0.0;
+  if (scan.includes_ssao_passes && !o.no_normals) {
+    report.begin("normal pass (ssao_passes.inc, %dx%d)... ", width, height);
+    // The basis of the camera every pass is rendered with, imposed on ssao_passes.inc (its
+    // SSAOCamera/SSAOCameraBasis vectors could describe another camera, e.g. with --camera-*).
+    std::vector<std::string> normal_pass = {"+Q6", "-A", "-UA", "Declare=SSAOPass=1"};
+    const std::pair<const char*, V3> axes[3] = {{"Right", normalized(reading.camera.right)},
+                                                {"Up", normalized(reading.camera.up)},
+                                                {"Forward", normalized(reading.camera.direction)}};
+    for (const auto& [name, axis] : axes) {
+      const double components[3] = {axis.x, axis.y, axis.z};
+      for (int c = 0; c < 3; ++c) {
+        char buffer[96];
+        std::snprintf(buffer, sizeof buffer, "Declare=SSAOBasis%s%c=%.17g", name, "XYZ"[c],
+                      components[c]);
+        normal_pass.push_back(buffer);
+      }
+    }
+    normal_seconds =
+        povray.render("normal pass", "normals", "normals.pov", width, height, normal_pass);
+    report.end("%.2f s", normal_seconds);
+    const ssao_io::Image image = ssao_io::read_image(scratch.file("normals.exr"));
+    double unit_fraction = 0.0;
+    std::vector<float> normals =
+        decode_normals(image, in.radial, scratch.file("normals.exr"), unit_fraction);
+    if (image.width != width || image.height != height || unit_fraction < 0.9) {
+      char buffer[64];
+      std::snprintf(buffer, sizeof buffer, "%.0f%%", 100.0 * unit_fraction);
+      report.warning(std::string("the normal pass does not decode to unit normals (") + buffer +
+                     " of the pixels do); are all textures wrapped in SSAOTexture()? Using "
+                     "normals reconstructed from the depth instead");
+    } else {
+      in.normals = std::move(normals);
+    }
+  }
+
+  // 5. AO and the outputs.
+  const double ao_seconds = compute_and_write(o, in, report);
+  std::string written = o.output + (o.exr.empty() ? "" : " and " + o.exr);
+  report.progress(
+      "wrote %s in %.2f s: pre-pass %.2f s, beauty %.2f s, depth %.2f s, "
+      "normals %.2f s, AO %.2f s",
+      written.c_str(), seconds_since(start), prepass_seconds, beauty_seconds, depth_seconds,
+      normal_seconds, ao_seconds);
+}
+
+void run_post_process(const Options& o) {
+  InterruptGuard interrupt_guard;
+  const Reporter report(o.quiet);
+  const auto start = Clock::now();
+  check_output_folder(o.output);
+  if (!o.exr.empty()) check_output_folder(o.exr);
+  for (const std::string& input : {o.beauty, o.depth}) {
+    if (same_file(o.output, input) || (!o.exr.empty() && same_file(o.exr, input))) {
+      throw UsageError("the output " + in_quotes(input) + " is an input file; choose another name");
+    }
+  }
+
+  ssao_io::Image beauty = ssao_io::read_image(o.beauty);
+  const std::string encoding = beauty.color_space;
+  if (ssao_io::linearize(beauty)) {
+    report.progress("beauty %s is %s-encoded: linearised before the multiplication",
+                    o.beauty.c_str(), encoding.c_str());
+  }
+  ssao_io::Image depth_image = ssao_io::read_image(o.depth);
+  if (beauty.width != depth_image.width || beauty.height != depth_image.height) {
+    throw ssao_io::Error("the beauty is " + std::to_string(beauty.width) + "x" +
+                         std::to_string(beauty.height) + " but the depth is " +
+                         std::to_string(depth_image.width) + "x" +
+                         std::to_string(depth_image.height));
+  }
+  std::string channel = o.depth_channel;
+  if (channel.empty()) {
+    for (const char* candidate : {"Radial", "Z", "R", "Y", "depth", "Depth"}) {
+      if (depth_image.find_channel(candidate) >= 0) {
+        channel = candidate;
+        break;
+      }
+    }
+    if (channel.empty() && depth_image.channels() == 1) channel = depth_image.channel_names[0];
+    if (channel.empty()) {
+      throw UsageError("cannot tell which channel of " + in_quotes(o.depth) +
+                       " holds the depth; name it with --depth-channel (channels: " +
+                       ssao_io::join_names(depth_image.channel_names) + ")");
+    }
+  }
+  const int index = ssao_io::require_channel(depth_image, channel, o.depth);
+  const ssao_io::ParamSetting* kind = o.param("depth_kind");
+  const bool planar = kind ? kind->string_value == "planar" : channel == "Z";
+
+  AoInputs in;
+  in.width = beauty.width;
+  in.height = beauty.height;
+  take_beauty(beauty, o.beauty, in);
+  const double aspect = o.camera_aspect
+                            ? *o.camera_aspect
+                            : static_cast<double>(in.width) / static_cast<double>(in.height);
+  in.camera = make_camera(o.camera.orthographic, o.camera.angle.value_or(0.0),
+                          o.camera_width.value_or(0.0), aspect);
+  std::vector<float> depth = ssao_io::extract_channels(depth_image, {index});
+  for (float& d : depth) {
+    d = static_cast<float>(d * o.depth_scale);
+    if (!(std::isfinite(d) && d > 0.0f)) d = kInfinity;
+  }
+  const bool depth_is_planar = planar || in.camera.orthographic;
+  fill_planar_and_radial(in, depth, depth_is_planar);
+  in.planar_input = depth_is_planar;
+  report.progress("%dx%d, depth channel %s (%s), camera %s", in.width, in.height, channel.c_str(),
+                  depth_is_planar ? "planar" : "radial", in.camera.summary().c_str());
+  compute_and_write(o, in, report);
+  report.progress("wrote %s%s in %.2f s", o.output.c_str(),
+                  o.exr.empty() ? "" : (" and " + o.exr).c_str(), seconds_since(start));
+}
+
+}  // namespace povray_ssao

@@ -1,0 +1,519 @@
+// SPDX-License-Identifier: MIT
+#include "options.h"
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+
+#include "io/camera_json.h"
+#include "io/image_io.h"
+
+namespace povray_ssao {
+namespace {
+
+using ssao_io::help_entry;
+using ssao_io::parse_float;
+using ssao_io::parse_int;
+
+V3 parse_vector(const std::string& flag, const std::string& text) {
+  const std::vector<std::string> parts = ssao_io::split(text, ',');
+  if (parts.size() != 3) {
+    throw UsageError(flag + " expects X,Y,Z (three comma-separated numbers), got '" + text + "'");
+  }
+  return {parse_float(flag, parts[0]), parse_float(flag, parts[1]), parse_float(flag, parts[2])};
+}
+
+int parse_size(const std::string& flag, const std::string& text) {
+  const int value = parse_int(flag, text);
+  if (value < 1 || value > 65536) throw UsageError(flag + " must be 1..65536, got " + text);
+  return value;
+}
+
+double parse_positive(const std::string& flag, const std::string& text) {
+  const double value = parse_float(flag, text);
+  if (!(value > 0.0)) throw UsageError(flag + " must be positive, got " + text);
+  return value;
+}
+
+std::string upper(std::string text) {
+  std::transform(text.begin(), text.end(), text.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::toupper(c)); });
+  return text;
+}
+
+// Front-end options (not library parameters): the table drives parsing, --help and
+// suggestions.
+struct FrontOption {
+  enum Group { kRender, kCamera, kPost, kOther };
+  Group group;
+  const char* flag;
+  const char* alias;    // short form or nullptr
+  const char* metavar;  // nullptr for a switch
+  const char* help;
+  void (*apply)(Options& out, const std::string& flag, const std::string& value);
+};
+
+const std::vector<FrontOption>& front_options() {
+  static const std::vector<FrontOption> options = {
+      {FrontOption::kRender, "--output", "-o", "OUT.png",
+       "output (required): .png, .jpg or .tif: an 8-bit sRGB image of beauty x AO; .exr: the "
+       "channels of --exr (with --depth-only: Z and Radial)",
+       [](Options& o, const std::string&, const std::string& v) { o.output = v; }},
+      {FrontOption::kRender, "--width", nullptr, "W",
+       "image width, as +W640 or -W640 (default: the INI file's, else POV-Ray's default, see "
+       "below)",
+       [](Options& o, const std::string& f, const std::string& v) { o.width = parse_size(f, v); }},
+      {FrontOption::kRender, "--height", nullptr, "H", "image height, as +H480 or -H480",
+       [](Options& o, const std::string& f, const std::string& v) { o.height = parse_size(f, v); }},
+      {FrontOption::kRender, "--ini", nullptr, "FILE.ini",
+       "INI file given to every povray run before povray-ssao's own options (quality, "
+       "antialiasing, Declare=...); its Width and Height set the size unless given here",
+       [](Options& o, const std::string&, const std::string& v) { o.ini = v; }},
+      {FrontOption::kRender, "--exr", nullptr, "OUT.exr",
+       "also write 32-bit float channels R,G,B,A (beauty x AO, linear; A = 1 without alpha), "
+       "AO, Z (planar depth along the view axis; background inf) and Radial (distance from the "
+       "camera; background inf)",
+       [](Options& o, const std::string&, const std::string& v) { o.exr = v; }},
+      {FrontOption::kRender, "--keep", nullptr, "DIR",
+       "keep the generated wrappers, the povray logs and every pass in DIR (created if needed; "
+       "kept on failure too)",
+       [](Options& o, const std::string&, const std::string& v) { o.keep = v; }},
+      {FrontOption::kRender, "--depth-only", nullptr, nullptr,
+       "render only the pre-pass and the depth pass and write -o OUT.exr with channels Z and "
+       "Radial",
+       [](Options& o, const std::string&, const std::string&) { o.depth_only = true; }},
+      {FrontOption::kRender, "--povray", nullptr, "PATH",
+       "POV-Ray 3.7 executable (default: povray in PATH)",
+       [](Options& o, const std::string&, const std::string& v) { o.povray = v; }},
+      {FrontOption::kRender, "--fog-distances", nullptr, "D1,D2[,D3]",
+       "skip the pre-pass and use these fog distances (scene units; D3 adds a third fog on B "
+       "for far depths)",
+       [](Options& o, const std::string& f, const std::string& v) {
+         const std::vector<std::string> parts = ssao_io::split(v, ',');
+         if (parts.size() != 2 && parts.size() != 3) {
+           throw UsageError(f + " expects D1,D2 or D1,D2,D3, got '" + v + "'");
+         }
+         FogDistances d;
+         d.d1 = parse_positive(f, parts[0]);
+         d.d2 = parse_positive(f, parts[1]);
+         if (parts.size() == 3) d.d3 = parse_positive(f, parts[2]);
+         if (!(d.d1 < d.d2) || (d.d3 > 0.0 && !(d.d2 < d.d3))) {
+           throw UsageError(f + " must increase: D1 < D2 < D3, got '" + v + "'");
+         }
+         o.fog_distances = d;
+       }},
+      {FrontOption::kRender, "--no-normals", nullptr, nullptr,
+       "skip the normal pass of scenes that include ssao_passes.inc: reconstruct normals from "
+       "the depth",
+       [](Options& o, const std::string&, const std::string&) { o.no_normals = true; }},
+      {FrontOption::kRender, "--print-camera", nullptr, nullptr,
+       "print the camera read from the scene, the camera block every pass is rendered with and "
+       "libssao's camera parameters, then exit (no rendering)",
+       [](Options& o, const std::string&, const std::string&) { o.print_camera = true; }},
+      {FrontOption::kCamera, "--camera-location", nullptr, "X,Y,Z", "camera location",
+       [](Options& o, const std::string& f, const std::string& v) {
+         o.camera.location = parse_vector(f, v);
+       }},
+      {FrontOption::kCamera, "--camera-look-at", nullptr, "X,Y,Z", "point looked at",
+       [](Options& o, const std::string& f, const std::string& v) {
+         o.camera.look_at = parse_vector(f, v);
+       }},
+      {FrontOption::kCamera, "--camera-angle", nullptr, "DEG",
+       "horizontal field of view in degrees (POV-Ray's angle); in post-process mode the "
+       "perspective camera's",
+       [](Options& o, const std::string& f, const std::string& v) {
+         o.camera.angle = parse_float(f, v);
+       }},
+      {FrontOption::kCamera, "--camera-right", nullptr, "X,Y,Z", "right vector",
+       [](Options& o, const std::string& f, const std::string& v) {
+         o.camera.right = parse_vector(f, v);
+       }},
+      {FrontOption::kCamera, "--camera-up", nullptr, "X,Y,Z", "up vector",
+       [](Options& o, const std::string& f, const std::string& v) {
+         o.camera.up = parse_vector(f, v);
+       }},
+      {FrontOption::kCamera, "--camera-sky", nullptr, "X,Y,Z", "sky vector (used by look_at)",
+       [](Options& o, const std::string& f, const std::string& v) {
+         o.camera.sky = parse_vector(f, v);
+       }},
+      {FrontOption::kCamera, "--camera-direction", nullptr, "X,Y,Z", "direction vector",
+       [](Options& o, const std::string& f, const std::string& v) {
+         o.camera.direction = parse_vector(f, v);
+       }},
+      {FrontOption::kCamera, "--camera-orthographic", nullptr, nullptr,
+       "an orthographic camera (in post-process mode with --camera-width)",
+       [](Options& o, const std::string&, const std::string&) { o.camera.orthographic = true; }},
+      {FrontOption::kPost, "--beauty", nullptr, "IMAGE",
+       "the rendered image: EXR (linear) or PNG/TIFF/... (sRGB-encoded files are linearised)",
+       [](Options& o, const std::string&, const std::string& v) { o.beauty = v; }},
+      {FrontOption::kPost, "--depth", nullptr, "DEPTH.exr",
+       "the depth image, e.g. from --depth-only or --exr (a PNG must hold linear values: "
+       "POV-Ray's File_Gamma=1.0; scale them with --depth-scale)",
+       [](Options& o, const std::string&, const std::string& v) { o.depth = v; }},
+      {FrontOption::kPost, "--depth-channel", nullptr, "NAME",
+       "depth channel (default: Radial, else Z, else R, Y, depth or the only channel)",
+       [](Options& o, const std::string&, const std::string& v) { o.depth_channel = v; }},
+      {FrontOption::kPost, "--depth-scale", nullptr, "S",
+       "multiply the depth values by S (default 1)",
+       [](Options& o, const std::string& f, const std::string& v) {
+         o.depth_scale = parse_positive(f, v);
+       }},
+      {FrontOption::kPost, "--camera-aspect", nullptr, "R",
+       "|right| / |up| of the camera (default: the image's width / height, square pixels)",
+       [](Options& o, const std::string& f, const std::string& v) {
+         o.camera_aspect = parse_positive(f, v);
+       }},
+      {FrontOption::kPost, "--camera-width", nullptr, "W",
+       "view width in scene units of the orthographic camera (|right|)",
+       [](Options& o, const std::string& f, const std::string& v) {
+         o.camera_width = parse_positive(f, v);
+       }},
+      {FrontOption::kOther, "--quiet", "-q", nullptr,
+       "no progress and no warnings (errors are still shown)",
+       [](Options& o, const std::string&, const std::string&) { o.quiet = true; }},
+      {FrontOption::kOther, "--help", "-h", nullptr, "print this help and exit",
+       [](Options& o, const std::string&, const std::string&) { o.help = true; }},
+      {FrontOption::kOther, "--version", nullptr, nullptr, "print the library version and exit",
+       [](Options& o, const std::string&, const std::string&) { o.version = true; }},
+  };
+  return options;
+}
+
+const FrontOption* find_front_option(const std::string& flag) {
+  for (const FrontOption& option : front_options()) {
+    if (flag == option.flag || (option.alias && flag == option.alias)) return &option;
+  }
+  return nullptr;
+}
+
+// Library parameters povray-ssao sets itself from the POV-Ray camera and the passes.
+bool set_by_bridge(const std::string& name, bool post_process) {
+  if (ssao_io::is_camera_param(name)) return true;
+  if (name == "normal_space") return true;
+  return name == "depth_kind" && !post_process;
+}
+
+// +W640, -W640, +H480, -H480 (POV-Ray's switches, either sign).
+bool size_switch(const std::string& arg, Options& out) {
+  if (arg.size() < 3 || (arg[0] != '+' && arg[0] != '-')) return false;
+  const char key = static_cast<char>(std::toupper(static_cast<unsigned char>(arg[1])));
+  if (key != 'W' && key != 'H') return false;
+  if (!std::all_of(arg.begin() + 2, arg.end(), [](unsigned char c) { return std::isdigit(c); })) {
+    return false;
+  }
+  const int value = parse_size(arg, arg.substr(2));
+  (key == 'W' ? out.width : out.height) = value;
+  return true;
+}
+
+// Name=value: a POV-Ray INI option (Declare=Quality=2, Antialias_Threshold=0.1, ...).
+bool ini_option(const std::string& arg, Options& out) {
+  const size_t equals = arg.find('=');
+  if (equals == std::string::npos || equals == 0) return false;
+  const std::string name = arg.substr(0, equals);
+  if (!std::isalpha(static_cast<unsigned char>(name[0])) ||
+      !std::all_of(name.begin(), name.end(),
+                   [](unsigned char c) { return std::isalnum(c) || c == '_'; })) {
+    return false;
+  }
+  const std::string key = upper(name);
+  if (key == "WIDTH" || key == "HEIGHT") {
+    (key == "WIDTH" ? out.width : out.height) = parse_size(name, arg.substr(equals + 1));
+    return true;
+  }
+  if (key == "INPUT_FILE_NAME" || key == "OUTPUT_FILE_NAME" || key == "OUTPUT_FILE_TYPE" ||
+      key == "OUTPUT_TO_FILE") {
+    throw UsageError(arg +
+                     ": povray-ssao sets the input and output files of every povray run; "
+                     "give the scene as SCENE.pov and the output with -o");
+  }
+  out.povray_options.push_back(arg);
+  return true;
+}
+
+void pov_switch(const std::string& arg, Options& out) {
+  const char key = static_cast<char>(std::toupper(static_cast<unsigned char>(arg[1])));
+  if (key == 'I' || key == 'O' || key == 'F') {
+    throw UsageError(arg +
+                     ": povray-ssao sets the input file, the output file and its type of "
+                     "every povray run; give the scene as SCENE.pov and the output with -o");
+  }
+  out.povray_options.push_back(arg);
+}
+
+bool has_extension(const std::string& path, const std::string& extension) {
+  if (path.size() < extension.size()) return false;
+  std::string tail = path.substr(path.size() - extension.size());
+  std::transform(tail.begin(), tail.end(), tail.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  return tail == extension;
+}
+
+void check_output_name(const std::string& flag, const std::string& path, bool allow_preview) {
+  if (has_extension(path, ".exr")) return;
+  if (allow_preview && ssao_io::is_preview_path(path)) return;
+  throw UsageError(flag + " " + path +
+                   (allow_preview ? ": use .png, .jpg or .tif (8-bit sRGB) or .exr (float)"
+                                  : ": must be an OpenEXR file (.exr)"));
+}
+
+void validate(const Options& o) {
+  if (o.output.empty() && !o.print_camera) throw UsageError("missing the output: -o OUT.png");
+  if (!o.exr.empty()) {
+    check_output_name("--exr", o.exr, false);
+    if (o.exr == o.output) throw UsageError("-o and --exr name the same file");
+  }
+  const bool post = o.post_process();
+  for (const ssao_io::ParamSetting& p : o.params) {
+    if (set_by_bridge(p.name, post)) {
+      throw UsageError(p.flag + ": povray-ssao sets " + p.name +
+                       " itself from the POV-Ray camera and passes" +
+                       (post ? std::string(" (give the camera with --camera-angle, "
+                                           "--camera-aspect or --camera-orthographic "
+                                           "--camera-width)")
+                             : std::string(" (use the --camera-* flags to change the camera)")));
+    }
+  }
+  if (post) {
+    if (!o.scene.empty()) {
+      throw UsageError("a scene file ('" + o.scene +
+                       "') and --beauty/--depth: choose the render mode or the post-process "
+                       "mode");
+    }
+    if (o.beauty.empty()) throw UsageError("post-process mode needs --beauty IMAGE");
+    if (o.depth.empty()) throw UsageError("post-process mode needs --depth DEPTH.exr");
+    check_output_name("-o", o.output, true);
+    if (o.width || o.height || !o.ini.empty() || !o.keep.empty() || o.depth_only ||
+        o.fog_distances || o.print_camera || o.no_normals || !o.povray_options.empty() ||
+        o.povray != "povray") {
+      throw UsageError(
+          "post-process mode (--beauty, --depth) runs no povray: size, --ini, "
+          "--keep, --depth-only, --fog-distances, --print-camera, --povray and "
+          "POV-Ray options do not apply");
+    }
+    const CameraOverrides& c = o.camera;
+    if (c.location || c.look_at || c.right || c.up || c.sky || c.direction) {
+      throw UsageError(
+          "post-process mode takes the camera as --camera-angle DEG "
+          "[--camera-aspect R] or --camera-orthographic --camera-width W");
+    }
+    if (c.orthographic) {
+      if (!o.camera_width) throw UsageError("--camera-orthographic needs --camera-width W");
+      if (c.angle) throw UsageError("--camera-angle and --camera-orthographic contradict");
+    } else {
+      if (!c.angle) {
+        throw UsageError(
+            "post-process mode needs the camera: --camera-angle DEG (horizontal "
+            "field of view) or --camera-orthographic --camera-width W");
+      }
+      if (!(*c.angle > 0.0 && *c.angle < 180.0)) {
+        throw UsageError("--camera-angle must be in (0, 180) degrees");
+      }
+      if (o.camera_width) throw UsageError("--camera-width needs --camera-orthographic");
+    }
+    return;
+  }
+  if (o.scene.empty()) throw UsageError("missing the scene file SCENE.pov");
+  if (o.camera_aspect || o.camera_width || !o.depth_channel.empty() || o.depth_scale != 1.0) {
+    throw UsageError(
+        "--camera-aspect, --camera-width, --depth-channel and --depth-scale belong "
+        "to the post-process mode (--beauty, --depth)");
+  }
+  if (o.depth_only) {
+    if (!has_extension(o.output, ".exr")) {
+      throw UsageError(
+          "--depth-only writes float depth (channels Z and Radial): -o must be an "
+          ".exr file, got '" +
+          o.output + "'");
+    }
+    if (!o.exr.empty()) throw UsageError("--depth-only writes -o only; drop --exr");
+    if (!o.params.empty()) {
+      throw UsageError(o.params.front().flag + ": --depth-only computes no AO");
+    }
+  } else if (!o.print_camera) {
+    check_output_name("-o", o.output, true);
+  }
+}
+
+}  // namespace
+
+const ssao_io::ParamSetting* Options::param(const std::string& name) const {
+  const ssao_io::ParamSetting* found = nullptr;
+  for (const ssao_io::ParamSetting& p : params) {
+    if (p.name == name) found = &p;
+  }
+  return found;
+}
+
+Options parse_args(int argc, const char* const* argv, const std::vector<ssao_param_desc>& table) {
+  Options out;
+  for (int i = 1; i < argc; ++i) {
+    const std::string arg = argv[i];
+    if (arg == "--help" || arg == "-h") {
+      out.help = true;
+      return out;
+    }
+    if (arg == "--version") {
+      out.version = true;
+      return out;
+    }
+  }
+  bool only_positionals = false;
+  for (int i = 1; i < argc; ++i) {
+    const std::string arg = argv[i];
+    if (!only_positionals && arg == "--") {
+      only_positionals = true;
+      continue;
+    }
+    if (!only_positionals && size_switch(arg, out)) continue;
+    if (!only_positionals && arg.size() > 1 && arg[0] == '+') {
+      pov_switch(arg, out);
+      continue;
+    }
+    const bool is_option = !only_positionals && arg.size() > 1 && arg[0] == '-';
+    if (!is_option) {
+      if (!only_positionals && ini_option(arg, out)) continue;
+      if (arg.empty()) throw UsageError("empty scene file name");
+      if (!out.scene.empty()) {
+        throw UsageError("more than one scene file: '" + out.scene + "' and '" + arg + "'");
+      }
+      out.scene = arg;
+      continue;
+    }
+    std::string flag = arg;
+    std::string value;
+    bool has_inline_value = false;
+    const size_t equals = arg.find('=');
+    if (arg.rfind("--", 0) == 0 && equals != std::string::npos) {
+      flag = arg.substr(0, equals);
+      value = arg.substr(equals + 1);
+      has_inline_value = true;
+    }
+    const FrontOption* option = find_front_option(flag);
+    const ssao_param_desc* param = option ? nullptr : ssao_io::find_param(flag, table);
+    if (!option && !param) {
+      std::vector<std::string> known;
+      for (const FrontOption& o : front_options()) known.push_back(o.flag);
+      for (const ssao_param_desc& desc : table) known.push_back(ssao_io::flag_for(desc.name));
+      throw UsageError(ssao_io::unknown_option_message(flag, known));
+    }
+    const bool takes_value = param != nullptr || option->metavar != nullptr;
+    if (!takes_value) {
+      if (has_inline_value) throw UsageError(flag + " takes no value");
+      option->apply(out, option->flag, "");
+      continue;
+    }
+    if (!has_inline_value) {
+      if (i + 1 >= argc) throw UsageError(flag + " requires a value");
+      value = argv[++i];
+    }
+    if (param) {
+      out.params.push_back(ssao_io::parse_param(*param, flag, value));
+    } else {
+      if (value.empty()) throw UsageError(flag + " requires a non-empty value");
+      option->apply(out, option->flag, value);
+    }
+  }
+  validate(out);
+  return out;
+}
+
+std::string usage_text(const std::vector<ssao_param_desc>& table) {
+  std::string text =
+      "Usage: povray-ssao SCENE.pov -o OUT.png [+W640 +H480] [--ini FILE.ini] [--exr OUT.exr]\n"
+      "                   [--keep DIR] [--depth-only] [--povray PATH] [--quiet]\n"
+      "                   [--camera-* overrides] [AO parameters: --radius X, --samples N, ...]\n"
+      "       povray-ssao --beauty IMAGE --depth DEPTH.exr [--depth-channel NAME]\n"
+      "                   [--depth-kind radial|planar] (--camera-angle DEG [--camera-aspect R] |\n"
+      "                   --camera-orthographic --camera-width W) -o OUT.png [--exr OUT.exr]\n"
+      "\n"
+      "Screen-space ambient occlusion for POV-Ray 3.7 scenes. POV-Ray has no depth output, so\n"
+      "povray-ssao renders the scene several times: a small pre-pass that measures the depth\n"
+      "range, the beauty (with your quality settings), a depth pass (the scene wrapped so that\n"
+      "two additive fogs encode the distance: +Q9 -A +FE) and, for scenes that include\n"
+      "ssao_passes.inc, an exact normal pass. It computes AO with libssao and writes\n"
+      "OUT.png = beauty x AO, multiplied in linear light; the background is left unchanged.\n"
+      "\n"
+      "Render mode:\n";
+  text += help_entry("SCENE.pov",
+                     "the scene; every povray run works in its folder, with +L for that folder");
+  auto section = [&](FrontOption::Group group) {
+    for (const FrontOption& option : front_options()) {
+      if (option.group != group) continue;
+      std::string left =
+          option.alias ? std::string(option.alias) + ", " + option.flag : option.flag;
+      if (option.metavar) left += std::string(" ") + option.metavar;
+      text += help_entry(left, option.help);
+    }
+  };
+  section(FrontOption::kRender);
+  text += help_entry("+SWITCH, NAME=VALUE",
+                     "any other POV-Ray option (+A0.3, +R3, +K0.5, Declare=Detail=2, ...) goes "
+                     "to every povray run before povray-ssao's own options, which override it in "
+                     "the data passes (+Q9 -A -UA +FE for depth, +Q6 -A -UA +FE for normals); +I, "
+                     "+O and +F are povray-ssao's");
+  text +=
+      "\nCamera (read from the scene: the last camera { } block, or SSAOCamera(...) of\n"
+      "ssao_passes.inc; a flag replaces the value read, and location with look_at or direction\n"
+      "replaces a camera that cannot be read):\n";
+  section(FrontOption::kCamera);
+  text += "\nPost-process mode (no povray run; the camera from flags):\n";
+  section(FrontOption::kPost);
+  text += help_entry("--depth-kind radial|planar",
+                     "libssao's depth_kind: radial, the distance along the pixel's ray (POV-Ray's "
+                     "fog depth, the Radial channel), or planar, along the view axis (the Z "
+                     "channel); default planar for a channel named Z, radial otherwise");
+  text += "\nOther:\n";
+  section(FrontOption::kOther);
+  text +=
+      "\nAO parameters (libssao's parameter table; --NAME_WITH_UNDERSCORES is written with\n"
+      "dashes; the camera parameters, depth_kind and normal_space are set by povray-ssao):\n";
+  text += ssao_io::param_help(
+      table, [](const ssao_param_desc& desc) { return !set_by_bridge(desc.name, false); });
+  text +=
+      "\n"
+      "How povray-ssao chooses its values:\n"
+      "  Size      --width/--height or +W/+H, else Width/Height of --ini, else of the first\n"
+      "            povray.ini POV-Ray reads ($POVINI, ./povray.ini, ~/.povray/3.7/povray.ini,\n"
+      "            /etc/povray/3.7/povray.ini), else 160x120. Every povray run gets +W +H.\n"
+      "  Camera    POV-Ray's SDL cannot report its camera, so povray-ssao reads the scene's\n"
+      "            last camera { } block: location, look_at, angle, right, up, direction, sky,\n"
+      "            perspective/orthographic, translate/rotate/scale/matrix, with numbers,\n"
+      "            vectors <a,b,c>, + - * / ( ), x y z, image_width, image_height, functions\n"
+      "            (sqrt, sin, vnormalize, ...) and identifiers #declared/#local earlier as\n"
+      "            numbers or vectors. Include files are read where POV-Ray finds them, and\n"
+      "            #if/#switch conditions that can be evaluated (Declare= values included)\n"
+      "            choose their branch. Other camera types (fisheye, panoramic, ...) and\n"
+      "            macro-made cameras are refused. The resolved camera is declared again\n"
+      "            after the scene in every pass, the beauty included, so all passes agree; it\n"
+      "            has no focal blur (aperture): a warning says when the scene had some.\n"
+      "            libssao: perspective lens = 36 / (2 tan(angle / 2)) mm on a 36 mm sensor\n"
+      "            fitted horizontally; orthographic ortho_scale = |right|; pixel aspect from\n"
+      "            |right| / |up| against W / H.\n"
+      "  Depth     d = -D log1p(-R / 60000) from the fog on R, or from the fog on G once\n"
+      "            d >= 0.7 D1; rays that hit nothing (R = G = 60000) are background (AO 1,\n"
+      "            Z = inf). EXR output is half-float, so the error depends on x = d / D:\n"
+      "            about 4e-4 of d for x in 0.1..0.7. The pre-pass (1/8 of the size, at most\n"
+      "            80 pixels wide, fogs 1, 100 and 10000) measures the depths; then\n"
+      "            D1 = 1.5 x the median depth and D2 = the 99th percentile / 2, kept within\n"
+      "            10..40 x D1; if the farthest depth exceeds 2 x D2, a third fog on B with\n"
+      "            D3 = the farthest depth (at least 10 x D2) reads the far range beyond\n"
+      "            2 x D2. Depths beyond about 8 x the last fog's distance read as background.\n"
+      "            The estimated error of the depth is printed. Glass and mirrors give the\n"
+      "            depth of their own surface; no_image objects are not seen.\n"
+      "  Radius    without --radius: 5% of the median depth (perspective) or of the view\n"
+      "            width |right| (orthographic), in scene units; printed.\n"
+      "  Normals   reconstructed from the depth by libssao, except for scenes that include\n"
+      "            \"ssao_passes.inc\": their exact normal pass (Declare=SSAOPass=1 +Q6, the\n"
+      "            rendered camera's basis given as Declare=SSAOBasis...).\n"
+      "  Includes  +L<the scene's folder> and +L<povray-ssao's includes: ssao_depth_pre.inc,\n"
+      "            ssao_depth_post.inc, ssao_passes.inc> (<bin>/../share/povray-ssao, else the\n"
+      "            source tree's povray_bridge/pov) on every povray run.\n"
+      "\n"
+      "Progress and timings go to stdout; warnings, errors and POV-Ray's error lines to stderr.\n"
+      "Outputs are written to a temporary name and renamed when complete.\n"
+      "Exit status: 0 success, 1 failure (nothing written), 2 command-line error.\n";
+  return text;
+}
+
+}  // namespace povray_ssao

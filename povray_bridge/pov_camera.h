@@ -1,0 +1,83 @@
+// SPDX-License-Identifier: MIT
+// POV-Ray 3.7's camera: what povray-ssao reads from the scene text (the last camera { } block,
+// or an SSAOCamera(...) call of ssao_passes.inc), the --camera-* overrides, the resolution of
+// location/look_at/angle/right/up/direction/sky/transforms into four vectors exactly as POV-Ray's
+// Parse_Camera does (3.5+ rules), the camera block povray-ssao writes after the scene in every
+// pass, and the mapping to libssao's Blender-style camera parameters.
+//
+// POV-Ray's camera model (tracepixel.cpp): the ray of pixel (i, j), row 0 at the top, is
+// D + x0 R + y0 U with x0 = (i + 0.5) / W - 0.5 and y0 = 0.5 - (j + 0.5) / H, so |R| / |D| is
+// the view width at unit distance: angle A (horizontal) gives |D| = |R| / (2 tan(A / 2)).
+// Orthographic rays start at location + x0 R + y0 U and travel along D.
+#pragma once
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "io/job.h"
+#include "sdl.h"
+
+namespace povray_ssao {
+
+// The --camera-* flags (each optional).
+struct CameraOverrides {
+  std::optional<V3> location, look_at, right, up, direction, sky;
+  std::optional<double> angle;
+  bool orthographic = false;
+  bool any() const {
+    return location || look_at || right || up || direction || sky || angle || orthographic;
+  }
+  // Enough to define a camera without the scene's block.
+  bool complete() const { return location && (look_at || direction); }
+};
+
+// A camera as four vectors: what POV-Ray traces with.
+struct ResolvedCamera {
+  bool orthographic = false;
+  V3 location{0, 0, 0};
+  V3 direction{0, 0, 1};
+  V3 right{1.33, 0, 0};
+  V3 up{0, 1, 0};
+
+  // Horizontal field of view in degrees (perspective).
+  double horizontal_fov() const;
+  // |right| / |up|: the image aspect ratio the camera is made for.
+  double aspect() const;
+
+  // A camera { } block that reproduces this camera whatever the #version in effect.
+  std::string to_sdl() const;
+
+  // One line for the progress output.
+  std::string summary() const;
+
+  // Sets camera_type, lens or ortho_scale, sensor_width 36, sensor_fit HORIZONTAL and the
+  // pixel aspect for a W x H image so that libssao's pixel <-> view mapping is POV-Ray's.
+  void apply_to_job(ssao_io::Job& job, int width, int height) const;
+
+  // radial distance / planar depth of pixel (px, py): 1 for orthographic cameras.
+  double radial_factor(int px, int py, int width, int height) const;
+
+ private:
+  void set_job_camera(ssao_io::Job& job, int width, int height) const;
+};
+
+struct CameraReading {
+  ResolvedCamera camera;
+  std::string source;                 // "scene.pov:25", "--camera-* flags", ...
+  bool had_focal_blur = false;        // the block sets a non-zero aperture (or may, under #if)
+  std::vector<std::string> warnings;  // for the user
+};
+
+// The camera of a scan with the overrides applied on top. Throws ssao_io::Error with a message
+// naming what could not be read and suggesting the --camera-* flags, when the camera is of
+// another type (fisheye, panoramic, ...), when an expression cannot be evaluated, or when no
+// camera block is found (unless the overrides are complete: location and look_at or direction).
+CameraReading read_camera(const SceneScan& scan, const CameraOverrides& overrides, int width,
+                          int height);
+
+// Camera for a post-process run: perspective with horizontal FOV `angle` (degrees), or
+// orthographic `ortho_width` wide; `aspect` = |right| / |up| (the image's W/H for square pixels).
+ResolvedCamera make_camera(bool orthographic, double angle, double ortho_width, double aspect);
+
+}  // namespace povray_ssao

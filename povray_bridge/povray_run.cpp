@@ -1,0 +1,340 @@
+// SPDX-License-Identifier: MIT
+#include "povray_run.h"
+
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cctype>
+#include <cerrno>
+#include <chrono>
+#include <csignal>
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+namespace povray_ssao {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+volatile std::sig_atomic_t g_interrupted = 0;
+extern "C" void on_interrupt(int) { g_interrupted = 1; }
+
+bool is_executable_file(const std::string& path) {
+  std::error_code ec;
+  return fs::is_regular_file(path, ec) && ::access(path.c_str(), X_OK) == 0;
+}
+
+std::string lower(std::string text) {
+  std::transform(text.begin(), text.end(), text.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  return text;
+}
+
+std::string trim(const std::string& text) {
+  size_t begin = 0, end = text.size();
+  while (begin < end && std::isspace(static_cast<unsigned char>(text[begin]))) ++begin;
+  while (end > begin && std::isspace(static_cast<unsigned char>(text[end - 1]))) --end;
+  return text.substr(begin, end - begin);
+}
+
+int parse_positive(const std::string& text) {
+  char* end = nullptr;
+  const long value = std::strtol(text.c_str(), &end, 10);
+  if (end == text.c_str() || value <= 0 || value > 1000000) return 0;
+  return static_cast<int>(value);
+}
+
+}  // namespace
+
+std::string find_executable(const std::string& name) {
+  if (name.find('/') != std::string::npos) {
+    if (is_executable_file(name)) return name;
+    throw ssao_io::Error("cannot run POV-Ray: '" + name + "' is not an executable file");
+  }
+  const char* path = std::getenv("PATH");
+  std::stringstream folders(path ? path : "/usr/local/bin:/usr/bin:/bin");
+  std::string folder;
+  while (std::getline(folders, folder, ':')) {
+    if (folder.empty()) folder = ".";
+    const std::string candidate = folder + "/" + name;
+    if (is_executable_file(candidate)) return candidate;
+  }
+  throw ssao_io::Error("cannot run POV-Ray: no '" + name +
+                       "' in PATH (install POV-Ray 3.7, e.g. apt-get install povray, or give "
+                       "--povray PATH)");
+}
+
+RenderResult run_process(const std::string& executable, const std::vector<std::string>& args,
+                         const std::string& working_directory, const std::string& log_path) {
+  const int log = ::open(log_path.c_str(), O_WRONLY | O_CREAT | O_APPEND | O_CLOEXEC, 0644);
+  if (log < 0) {
+    throw ssao_io::Error("cannot create the log file '" + log_path + "': " + std::strerror(errno));
+  }
+  std::vector<std::string> argv_strings;
+  argv_strings.push_back(executable);
+  argv_strings.insert(argv_strings.end(), args.begin(), args.end());
+  std::vector<char*> argv;
+  for (std::string& arg : argv_strings) argv.push_back(arg.data());
+  argv.push_back(nullptr);
+
+  const auto start = std::chrono::steady_clock::now();
+  const pid_t child = ::fork();
+  if (child < 0) {
+    ::close(log);
+    throw ssao_io::Error(std::string("cannot start POV-Ray: fork failed: ") + std::strerror(errno));
+  }
+  if (child == 0) {
+    // The child: only async-signal-safe calls until exec.
+    const int null_in = ::open("/dev/null", O_RDONLY);
+    if (null_in >= 0) ::dup2(null_in, 0);
+    ::dup2(log, 1);
+    ::dup2(log, 2);
+    if (::chdir(working_directory.c_str()) != 0) {
+      const char message[] = "povray-ssao: cannot enter the scene's folder\n";
+      (void)!::write(2, message, sizeof message - 1);
+      ::_exit(126);
+    }
+    ::execv(executable.c_str(), argv.data());
+    const char message[] = "povray-ssao: cannot execute POV-Ray\n";
+    (void)!::write(2, message, sizeof message - 1);
+    ::_exit(127);
+  }
+  ::close(log);
+
+  int status = 0;
+  bool forwarded = false;
+  while (true) {
+    const pid_t done = ::waitpid(child, &status, 0);
+    if (done == child) break;
+    if (done < 0 && errno != EINTR) {
+      throw ssao_io::Error(std::string("waiting for POV-Ray failed: ") + std::strerror(errno));
+    }
+    if (g_interrupted && !forwarded) {
+      ::kill(child, SIGTERM);
+      forwarded = true;
+    }
+  }
+  RenderResult result;
+  result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  if (WIFEXITED(status)) {
+    result.exit_status = WEXITSTATUS(status);
+  } else if (WIFSIGNALED(status)) {
+    result.exit_status = 128 + WTERMSIG(status);
+  }
+  if (g_interrupted) throw ssao_io::Error("interrupted; nothing written");
+  if (result.exit_status == 127 || result.exit_status == 126) {
+    std::ifstream file(log_path);
+    std::string text((std::istreambuf_iterator<char>(file)), std::istreambuf_iterator<char>());
+    if (text.find("povray-ssao: cannot execute POV-Ray") != std::string::npos) {
+      throw ssao_io::Error("cannot execute '" + executable + "'");
+    }
+    if (text.find("povray-ssao: cannot enter the scene's folder") != std::string::npos) {
+      throw ssao_io::Error("cannot enter the scene's folder '" + working_directory + "'");
+    }
+  }
+  return result;
+}
+
+std::string povray_error_lines(const std::string& log_path, size_t max_lines) {
+  std::ifstream file(log_path);
+  std::vector<std::string> lines;
+  std::string line;
+  while (std::getline(file, line)) {
+    if (!trim(line).empty()) lines.push_back(line);
+  }
+  // POV-Ray's messages: "File 'x.pov' line 4: Parse Error: ...", "Possible Parse Error: ...",
+  // "Fatal error in parser: ...", "Render failed". The banner lists "Error Stream to console".
+  size_t first = lines.size();
+  for (size_t i = 0; i < lines.size(); ++i) {
+    const std::string& l = lines[i];
+    if (l.find("Stream to console") != std::string::npos) continue;
+    if (l.find("Error") != std::string::npos || l.find("Fatal error") != std::string::npos ||
+        l.find("povray-ssao:") == 0 || l.find("Render failed") != std::string::npos) {
+      if (l.find("povray-ssao: ") == 0 && l.find("cannot") == std::string::npos) continue;
+      first = i;
+      break;
+    }
+  }
+  if (first == lines.size()) first = lines.size() > max_lines ? lines.size() - max_lines : 0;
+  std::string out;
+  for (size_t i = first; i < lines.size() && i < first + max_lines; ++i) {
+    out += "  " + lines[i] + "\n";
+  }
+  return out;
+}
+
+void ini_size(const std::string& path, int& width, int& height) {
+  std::ifstream file(path);
+  if (!file) throw ssao_io::Error("cannot read the INI file '" + path + "'");
+  std::string line;
+  while (std::getline(file, line)) {
+    const size_t comment = line.find(';');
+    if (comment != std::string::npos) line.resize(comment);
+    line = trim(line);
+    if (line.empty()) continue;
+    if (line[0] == '[') break;  // POV-Ray reads only the unnamed section by default
+    if ((line[0] == '+' || line[0] == '-') && line.size() > 2) {
+      // Switches, possibly several on one line.
+      std::stringstream words(line);
+      std::string word;
+      while (words >> word) {
+        if (word.size() < 3 || (word[0] != '+' && word[0] != '-')) continue;
+        const char key = static_cast<char>(std::toupper(static_cast<unsigned char>(word[1])));
+        const int value = parse_positive(word.substr(2));
+        if (key == 'W' && value) width = value;
+        if (key == 'H' && value) height = value;
+      }
+      continue;
+    }
+    const size_t equals = line.find('=');
+    if (equals == std::string::npos) continue;
+    const std::string key = lower(trim(line.substr(0, equals)));
+    const int value = parse_positive(trim(line.substr(equals + 1)));
+    if (key == "width" && value) width = value;
+    if (key == "height" && value) height = value;
+  }
+}
+
+void ini_library_paths(const std::string& path, std::vector<std::string>& paths) {
+  std::ifstream file(path);
+  std::string line;
+  while (std::getline(file, line)) {
+    const size_t comment = line.find(';');
+    if (comment != std::string::npos) line.resize(comment);
+    line = trim(line);
+    if (line.empty()) continue;
+    if (line[0] == '[') break;
+    std::string value;
+    if ((line[0] == '+' || line[0] == '-') && line.size() > 2 &&
+        std::toupper(static_cast<unsigned char>(line[1])) == 'L') {
+      value = line.substr(2);
+    } else {
+      const size_t equals = line.find('=');
+      if (equals == std::string::npos) continue;
+      if (lower(trim(line.substr(0, equals))) != "library_path") continue;
+      value = trim(line.substr(equals + 1));
+    }
+    if (value.size() >= 2 && value.front() == '"' && value.back() == '"') {
+      value = value.substr(1, value.size() - 2);
+    }
+    if (!value.empty()) paths.push_back(value);
+  }
+}
+
+namespace {
+
+// One INI line or command-line option: Declare=NAME=VALUE, Clock=V or +KV.
+void declare_option(const std::string& text, std::vector<std::string>& declares, double& clock) {
+  const std::string option = trim(text);
+  if ((option[0] == '+' || option[0] == '-') && option.size() > 2 &&
+      std::toupper(static_cast<unsigned char>(option[1])) == 'K' &&
+      (std::isdigit(static_cast<unsigned char>(option[2])) || option[2] == '.' ||
+       option[2] == '-')) {
+    clock = std::strtod(option.c_str() + 2, nullptr);
+    return;
+  }
+  const size_t equals = option.find('=');
+  if (equals == std::string::npos) return;
+  const std::string key = lower(trim(option.substr(0, equals)));
+  const std::string value = trim(option.substr(equals + 1));
+  if (key == "declare") declares.push_back(value);
+  if (key == "clock") clock = std::strtod(value.c_str(), nullptr);
+}
+
+}  // namespace
+
+void ini_declares(const std::string& path, std::vector<std::string>& declares, double& clock) {
+  std::ifstream file(path);
+  std::string line;
+  while (std::getline(file, line)) {
+    const size_t comment = line.find(';');
+    if (comment != std::string::npos) line.resize(comment);
+    line = trim(line);
+    if (line.empty()) continue;
+    if (line[0] == '[') break;
+    if (line[0] == '+' || line[0] == '-') {
+      std::stringstream words(line);
+      std::string word;
+      while (words >> word) declare_option(word, declares, clock);
+      continue;
+    }
+    declare_option(line, declares, clock);
+  }
+}
+
+void option_declares(const std::vector<std::string>& options, std::vector<std::string>& declares,
+                     double& clock) {
+  for (const std::string& option : options) declare_option(option, declares, clock);
+}
+
+std::string system_ini(const std::string& working_directory) {
+  std::vector<std::string> candidates;
+  if (const char* env = std::getenv("POVINI")) candidates.push_back(env);
+  candidates.push_back(working_directory + "/povray.ini");
+  if (const char* home = std::getenv("HOME")) {
+    candidates.push_back(std::string(home) + "/.povray/3.7/povray.ini");
+  }
+  candidates.push_back("/etc/povray/3.7/povray.ini");
+  for (const std::string& candidate : candidates) {
+    std::error_code ec;
+    if (fs::is_regular_file(candidate, ec)) return candidate;  // POV-Ray reads only this one
+  }
+  return "";
+}
+
+void default_size(const std::string& working_directory, int& width, int& height) {
+  const std::string ini = system_ini(working_directory);
+  if (!ini.empty()) {
+    int w = 0, h = 0;
+    try {
+      ini_size(ini, w, h);
+    } catch (const ssao_io::Error&) {
+    }
+    if (width == 0) width = w;
+    if (height == 0) height = h;
+  }
+  if (width == 0) width = 160;
+  if (height == 0) height = 120;
+}
+
+ScratchFolder::ScratchFolder() {
+  const char* tmp = std::getenv("TMPDIR");
+  std::string pattern = std::string(tmp && *tmp ? tmp : "/tmp") + "/povray-ssao.XXXXXX";
+  std::vector<char> buffer(pattern.begin(), pattern.end());
+  buffer.push_back('\0');
+  if (!::mkdtemp(buffer.data())) {
+    throw ssao_io::Error("cannot create a scratch folder '" + pattern +
+                         "': " + std::strerror(errno));
+  }
+  path_ = buffer.data();
+}
+
+ScratchFolder::~ScratchFolder() {
+  std::error_code ec;
+  fs::remove_all(path_, ec);
+}
+
+InterruptGuard::InterruptGuard() {
+  struct sigaction action {};
+  action.sa_handler = on_interrupt;
+  sigemptyset(&action.sa_mask);
+  action.sa_flags = 0;  // no SA_RESTART: waitpid returns EINTR so that we can forward it
+  ::sigaction(SIGINT, &action, nullptr);
+  ::sigaction(SIGTERM, &action, nullptr);
+}
+
+InterruptGuard::~InterruptGuard() {
+  std::signal(SIGINT, SIG_DFL);
+  std::signal(SIGTERM, SIG_DFL);
+}
+
+bool InterruptGuard::interrupted() { return g_interrupted != 0; }
+
+}  // namespace povray_ssao

@@ -1,0 +1,79 @@
+// SPDX-License-Identifier: MIT
+// Running POV-Ray: the executable, one render with its output captured in a log file, the error
+// lines of a failed render, the image size POV-Ray would use, a scratch folder, Ctrl-C.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "io/error.h"
+
+namespace povray_ssao {
+
+// The full path of `name` (searched in PATH unless it contains a '/'). Throws ssao_io::Error
+// if there is no such executable.
+std::string find_executable(const std::string& name);
+
+struct RenderResult {
+  int exit_status = 0;   // POV-Ray's exit code (128 + signal if it was killed)
+  double seconds = 0.0;  // wall-clock time
+};
+
+// Runs `executable args...` in `working_directory` with stdin from /dev/null and stdout and
+// stderr appended to `log_path`. Throws ssao_io::Error if it cannot be started, or when the user
+// interrupted it (SIGINT/SIGTERM, forwarded to POV-Ray).
+RenderResult run_process(const std::string& executable, const std::vector<std::string>& args,
+                         const std::string& working_directory, const std::string& log_path);
+
+// The lines of a POV-Ray log that explain a failure (from the first error message on, at most
+// `max_lines`), or its last lines when it has no recognisable error message.
+std::string povray_error_lines(const std::string& log_path, size_t max_lines = 15);
+
+// Width and height set by an INI file (Width=, Height=, +W, +H before the first [section]);
+// 0 for a value it does not set. Throws ssao_io::Error if the file cannot be read.
+void ini_size(const std::string& path, int& width, int& height);
+
+// The library paths an INI file adds (Library_Path=..., +L...), appended to `paths`.
+void ini_library_paths(const std::string& path, std::vector<std::string>& paths);
+
+// The Declare=NAME=VALUE settings (appended to `declares` as NAME=VALUE) and the clock
+// (Clock=, +K) of an INI file or of a list of command-line options.
+void ini_declares(const std::string& path, std::vector<std::string>& declares, double& clock);
+void option_declares(const std::vector<std::string>& options, std::vector<std::string>& declares,
+                     double& clock);
+
+// The INI file POV-Ray reads at start-up: $POVINI, ./povray.ini in `working_directory`,
+// ~/.povray/3.7/povray.ini or /etc/povray/3.7/povray.ini, the first that exists; "" if none.
+std::string system_ini(const std::string& working_directory);
+
+// The size POV-Ray uses when the command line sets none: the first INI file POV-Ray reads at
+// start-up ($POVINI, ./povray.ini in `working_directory`, ~/.povray/3.7/povray.ini,
+// /etc/povray/3.7/povray.ini), else its built-in 160 x 120. Fills only values still 0.
+void default_size(const std::string& working_directory, int& width, int& height);
+
+// A private folder under $TMPDIR (or /tmp), removed with its contents on destruction.
+class ScratchFolder {
+ public:
+  ScratchFolder();
+  ~ScratchFolder();
+  ScratchFolder(const ScratchFolder&) = delete;
+  ScratchFolder& operator=(const ScratchFolder&) = delete;
+  const std::string& path() const { return path_; }
+  std::string file(const std::string& name) const { return path_ + "/" + name; }
+
+ private:
+  std::string path_;
+};
+
+// SIGINT and SIGTERM set a flag instead of killing the bridge (so that the scratch folder is
+// removed and no partial output is left); installed for the lifetime of the object.
+class InterruptGuard {
+ public:
+  InterruptGuard();
+  ~InterruptGuard();
+  InterruptGuard(const InterruptGuard&) = delete;
+  InterruptGuard& operator=(const InterruptGuard&) = delete;
+  static bool interrupted();
+};
+
+}  // namespace povray_ssao
