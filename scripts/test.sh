@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # SPDX-License-Identifier: MIT
 # Quick start, step 2 (and CI): installs what is missing, builds, and runs every test: the
-# release build (unit, cli, cycles ground truth), then the unit and cli tests again in an
+# release build (every label), then the unit, cli and povray tests again in an
 # AddressSanitizer + UndefinedBehaviorSanitizer build.
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
@@ -19,7 +19,7 @@ echo "== sanitizer tests"
 # Python test helpers would need the sanitizer runtime preloaded; the C++ tests and the CLI are
 # what the sanitizers are for.
 ASAN_OPTIONS=detect_leaks=1:abort_on_error=0 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
-  ctest --test-dir "$root/build-asan" -L "unit|cli" --output-on-failure -j"$jobs" || status=1
+  ctest --test-dir "$root/build-asan" -L "unit|cli|povray" --output-on-failure -j"$jobs" || status=1
 echo "== release tests"
 ctest --test-dir "$root/build" --output-on-failure -j"$jobs" || status=1
 exit $status
