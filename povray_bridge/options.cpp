@@ -43,49 +43,41 @@ std::string upper(std::string text) {
 
 // Front-end options (not library parameters): the table drives parsing, --help and
 // suggestions.
-struct FrontOption {
-  enum Group { kRender, kCamera, kPost, kOther };
-  Group group;
-  const char* flag;
-  const char* alias;    // short form or nullptr
-  const char* metavar;  // nullptr for a switch
-  const char* help;
-  void (*apply)(Options& out, const std::string& flag, const std::string& value);
-};
+enum Group { kRender, kCamera, kPost, kOther };
+using FrontOption = ssao_io::FrontOption<Options, Group>;
 
 const std::vector<FrontOption>& front_options() {
   static const std::vector<FrontOption> options = {
-      {FrontOption::kRender, "--output", "-o", "OUT.png",
+      {kRender, "--output", "-o", "OUT.png",
        "output (required): .png, .jpg or .tif: an 8-bit sRGB image of beauty x AO; .exr: the "
        "channels of --exr (with --depth-only: Z and Radial)",
        [](Options& o, const std::string&, const std::string& v) { o.output = v; }},
-      {FrontOption::kRender, "--width", nullptr, "W",
+      {kRender, "--width", nullptr, "W",
        "image width, as +W640 or -W640 (default: the INI file's, else POV-Ray's default, see "
        "below)",
        [](Options& o, const std::string& f, const std::string& v) { o.width = parse_size(f, v); }},
-      {FrontOption::kRender, "--height", nullptr, "H", "image height, as +H480 or -H480",
+      {kRender, "--height", nullptr, "H", "image height, as +H480 or -H480",
        [](Options& o, const std::string& f, const std::string& v) { o.height = parse_size(f, v); }},
-      {FrontOption::kRender, "--ini", nullptr, "FILE.ini",
+      {kRender, "--ini", nullptr, "FILE.ini",
        "INI file given to every povray run before povray-ssao's own options (quality, "
        "antialiasing, Declare=...); its Width and Height set the size unless given here",
        [](Options& o, const std::string&, const std::string& v) { o.ini = v; }},
-      {FrontOption::kRender, "--exr", nullptr, "OUT.exr",
+      {kRender, "--exr", nullptr, "OUT.exr",
        "also write 32-bit float channels R,G,B,A (beauty x AO, linear; A = 1 without alpha), "
        "AO, Z (planar depth along the view axis; background inf) and Radial (distance from the "
        "camera; background inf)",
        [](Options& o, const std::string&, const std::string& v) { o.exr = v; }},
-      {FrontOption::kRender, "--keep", nullptr, "DIR",
+      {kRender, "--keep", nullptr, "DIR",
        "keep the generated wrappers, the povray logs and every pass in DIR (created if needed; "
        "kept on failure too)",
        [](Options& o, const std::string&, const std::string& v) { o.keep = v; }},
-      {FrontOption::kRender, "--depth-only", nullptr, nullptr,
+      {kRender, "--depth-only", nullptr, nullptr,
        "render only the pre-pass and the depth pass and write -o OUT.exr with channels Z and "
        "Radial",
        [](Options& o, const std::string&, const std::string&) { o.depth_only = true; }},
-      {FrontOption::kRender, "--povray", nullptr, "PATH",
-       "POV-Ray 3.7 executable (default: povray in PATH)",
+      {kRender, "--povray", nullptr, "PATH", "POV-Ray 3.7 executable (default: povray in PATH)",
        [](Options& o, const std::string&, const std::string& v) { o.povray = v; }},
-      {FrontOption::kRender, "--fog-distances", nullptr, "D1,D2[,D3]",
+      {kRender, "--fog-distances", nullptr, "D1,D2[,D3]",
        "skip the pre-pass and use these fog distances (scene units; D3 adds a third fog on B "
        "for far depths)",
        [](Options& o, const std::string& f, const std::string& v) {
@@ -102,88 +94,79 @@ const std::vector<FrontOption>& front_options() {
          }
          o.fog_distances = d;
        }},
-      {FrontOption::kRender, "--no-normals", nullptr, nullptr,
+      {kRender, "--no-normals", nullptr, nullptr,
        "skip the normal pass of scenes that include ssao_passes.inc: reconstruct normals from "
        "the depth",
        [](Options& o, const std::string&, const std::string&) { o.no_normals = true; }},
-      {FrontOption::kRender, "--print-camera", nullptr, nullptr,
+      {kRender, "--print-camera", nullptr, nullptr,
        "print the camera read from the scene, the camera block every pass is rendered with and "
        "libssao's camera parameters, then exit (no rendering)",
        [](Options& o, const std::string&, const std::string&) { o.print_camera = true; }},
-      {FrontOption::kCamera, "--camera-location", nullptr, "X,Y,Z", "camera location",
+      {kCamera, "--camera-location", nullptr, "X,Y,Z", "camera location",
        [](Options& o, const std::string& f, const std::string& v) {
          o.camera.location = parse_vector(f, v);
        }},
-      {FrontOption::kCamera, "--camera-look-at", nullptr, "X,Y,Z", "point looked at",
+      {kCamera, "--camera-look-at", nullptr, "X,Y,Z", "point looked at",
        [](Options& o, const std::string& f, const std::string& v) {
          o.camera.look_at = parse_vector(f, v);
        }},
-      {FrontOption::kCamera, "--camera-angle", nullptr, "DEG",
+      {kCamera, "--camera-angle", nullptr, "DEG",
        "horizontal field of view in degrees (POV-Ray's angle); in post-process mode the "
        "perspective camera's",
        [](Options& o, const std::string& f, const std::string& v) {
          o.camera.angle = parse_float(f, v);
        }},
-      {FrontOption::kCamera, "--camera-right", nullptr, "X,Y,Z", "right vector",
+      {kCamera, "--camera-right", nullptr, "X,Y,Z", "right vector",
        [](Options& o, const std::string& f, const std::string& v) {
          o.camera.right = parse_vector(f, v);
        }},
-      {FrontOption::kCamera, "--camera-up", nullptr, "X,Y,Z", "up vector",
+      {kCamera, "--camera-up", nullptr, "X,Y,Z", "up vector",
        [](Options& o, const std::string& f, const std::string& v) {
          o.camera.up = parse_vector(f, v);
        }},
-      {FrontOption::kCamera, "--camera-sky", nullptr, "X,Y,Z", "sky vector (used by look_at)",
+      {kCamera, "--camera-sky", nullptr, "X,Y,Z", "sky vector (used by look_at)",
        [](Options& o, const std::string& f, const std::string& v) {
          o.camera.sky = parse_vector(f, v);
        }},
-      {FrontOption::kCamera, "--camera-direction", nullptr, "X,Y,Z", "direction vector",
+      {kCamera, "--camera-direction", nullptr, "X,Y,Z", "direction vector",
        [](Options& o, const std::string& f, const std::string& v) {
          o.camera.direction = parse_vector(f, v);
        }},
-      {FrontOption::kCamera, "--camera-orthographic", nullptr, nullptr,
+      {kCamera, "--camera-orthographic", nullptr, nullptr,
        "an orthographic camera (in post-process mode with --camera-width)",
        [](Options& o, const std::string&, const std::string&) { o.camera.orthographic = true; }},
-      {FrontOption::kPost, "--beauty", nullptr, "IMAGE",
+      {kPost, "--beauty", nullptr, "IMAGE",
        "the rendered image: EXR (linear) or PNG/TIFF/... (sRGB-encoded files are linearised)",
        [](Options& o, const std::string&, const std::string& v) { o.beauty = v; }},
-      {FrontOption::kPost, "--depth", nullptr, "DEPTH.exr",
+      {kPost, "--depth", nullptr, "DEPTH.exr",
        "the depth image, e.g. from --depth-only or --exr (a PNG must hold linear values: "
        "POV-Ray's File_Gamma=1.0; scale them with --depth-scale)",
        [](Options& o, const std::string&, const std::string& v) { o.depth = v; }},
-      {FrontOption::kPost, "--depth-channel", nullptr, "NAME",
+      {kPost, "--depth-channel", nullptr, "NAME",
        "depth channel (default: Radial, else Z, else R, Y, depth or the only channel)",
        [](Options& o, const std::string&, const std::string& v) { o.depth_channel = v; }},
-      {FrontOption::kPost, "--depth-scale", nullptr, "S",
-       "multiply the depth values by S (default 1)",
+      {kPost, "--depth-scale", nullptr, "S", "multiply the depth values by S (default 1)",
        [](Options& o, const std::string& f, const std::string& v) {
          o.depth_scale = parse_positive(f, v);
        }},
-      {FrontOption::kPost, "--camera-aspect", nullptr, "R",
+      {kPost, "--camera-aspect", nullptr, "R",
        "|right| / |up| of the camera (default: the image's width / height, square pixels)",
        [](Options& o, const std::string& f, const std::string& v) {
          o.camera_aspect = parse_positive(f, v);
        }},
-      {FrontOption::kPost, "--camera-width", nullptr, "W",
+      {kPost, "--camera-width", nullptr, "W",
        "view width in scene units of the orthographic camera (|right|)",
        [](Options& o, const std::string& f, const std::string& v) {
          o.camera_width = parse_positive(f, v);
        }},
-      {FrontOption::kOther, "--quiet", "-q", nullptr,
-       "no progress and no warnings (errors are still shown)",
+      {kOther, "--quiet", "-q", nullptr, "no progress and no warnings (errors are still shown)",
        [](Options& o, const std::string&, const std::string&) { o.quiet = true; }},
-      {FrontOption::kOther, "--help", "-h", nullptr, "print this help and exit",
+      {kOther, "--help", "-h", nullptr, "print this help and exit",
        [](Options& o, const std::string&, const std::string&) { o.help = true; }},
-      {FrontOption::kOther, "--version", nullptr, nullptr, "print the library version and exit",
+      {kOther, "--version", nullptr, nullptr, "print the library version and exit",
        [](Options& o, const std::string&, const std::string&) { o.version = true; }},
   };
   return options;
-}
-
-const FrontOption* find_front_option(const std::string& flag) {
-  for (const FrontOption& option : front_options()) {
-    if (flag == option.flag || (option.alias && flag == option.alias)) return &option;
-  }
-  return nullptr;
 }
 
 // Library parameters povray-ssao sets itself from the POV-Ray camera and the passes.
@@ -380,39 +363,7 @@ Options parse_args(int argc, const char* const* argv, const std::vector<ssao_par
       out.scene = arg;
       continue;
     }
-    std::string flag = arg;
-    std::string value;
-    bool has_inline_value = false;
-    const size_t equals = arg.find('=');
-    if (arg.rfind("--", 0) == 0 && equals != std::string::npos) {
-      flag = arg.substr(0, equals);
-      value = arg.substr(equals + 1);
-      has_inline_value = true;
-    }
-    const FrontOption* option = find_front_option(flag);
-    const ssao_param_desc* param = option ? nullptr : ssao_io::find_param(flag, table);
-    if (!option && !param) {
-      std::vector<std::string> known;
-      for (const FrontOption& o : front_options()) known.push_back(o.flag);
-      for (const ssao_param_desc& desc : table) known.push_back(ssao_io::flag_for(desc.name));
-      throw UsageError(ssao_io::unknown_option_message(flag, known));
-    }
-    const bool takes_value = param != nullptr || option->metavar != nullptr;
-    if (!takes_value) {
-      if (has_inline_value) throw UsageError(flag + " takes no value");
-      option->apply(out, option->flag, "");
-      continue;
-    }
-    if (!has_inline_value) {
-      if (i + 1 >= argc) throw UsageError(flag + " requires a value");
-      value = argv[++i];
-    }
-    if (param) {
-      out.params.push_back(ssao_io::parse_param(*param, flag, value));
-    } else {
-      if (value.empty()) throw UsageError(flag + " requires a non-empty value");
-      option->apply(out, option->flag, value);
-    }
+    ssao_io::parse_option(argc, argv, i, front_options(), table, out);
   }
   validate(out);
   return out;
@@ -437,7 +388,7 @@ std::string usage_text(const std::vector<ssao_param_desc>& table) {
       "Render mode:\n";
   text += help_entry("SCENE.pov",
                      "the scene; every povray run works in its folder, with +L for that folder");
-  auto section = [&](FrontOption::Group group) {
+  auto section = [&](Group group) {
     for (const FrontOption& option : front_options()) {
       if (option.group != group) continue;
       std::string left =
@@ -446,7 +397,7 @@ std::string usage_text(const std::vector<ssao_param_desc>& table) {
       text += help_entry(left, option.help);
     }
   };
-  section(FrontOption::kRender);
+  section(kRender);
   text += help_entry("+SWITCH, NAME=VALUE",
                      "any other POV-Ray option (+A0.3, +R3, +K0.5, Declare=Detail=2, ...) goes "
                      "to every povray run before povray-ssao's own options, which override it in "
@@ -456,15 +407,15 @@ std::string usage_text(const std::vector<ssao_param_desc>& table) {
       "\nCamera (read from the scene: the last camera { } block, or SSAOCamera(...) of\n"
       "ssao_passes.inc; a flag replaces the value read, and location with look_at or direction\n"
       "replaces a camera that cannot be read):\n";
-  section(FrontOption::kCamera);
+  section(kCamera);
   text += "\nPost-process mode (no povray run; the camera from flags):\n";
-  section(FrontOption::kPost);
+  section(kPost);
   text += help_entry("--depth-kind radial|planar",
                      "libssao's depth_kind: radial, the distance along the pixel's ray (POV-Ray's "
                      "fog depth, the Radial channel), or planar, along the view axis (the Z "
                      "channel); default planar for a channel named Z, radial otherwise");
   text += "\nOther:\n";
-  section(FrontOption::kOther);
+  section(kOther);
   text +=
       "\nAO parameters (libssao's parameter table; --NAME_WITH_UNDERSCORES is written with\n"
       "dashes; the camera parameters, depth_kind and normal_space are set by povray-ssao):\n";

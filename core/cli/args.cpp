@@ -31,64 +31,50 @@ std::vector<std::string> parse_channel_list(const std::string& flag, const std::
 }
 
 // Front-end options (not core parameters). The table drives parsing, --help and suggestions.
-struct FrontOption {
-  enum Group { kInputOutput, kOther };
-  Group group;
-  const char* flag;
-  const char* alias;    // short form or nullptr
-  const char* metavar;  // nullptr for a switch
-  const char* help;
-  void (*apply)(Options& out, const std::string& flag, const std::string& value);
-};
+enum Group { kInputOutput, kOther };
+using FrontOption = ssao_io::FrontOption<Options, Group>;
 
 const std::vector<FrontOption>& front_options() {
   static const std::vector<FrontOption> options = {
-      {FrontOption::kInputOutput, "--output", "-o", "OUT.exr",
+      {kInputOutput, "--output", "-o", "OUT.exr",
        "output file (required): .exr writes float data (ZIP); .png, .jpg or .tif an 8-bit sRGB "
        "preview; written to a temporary file and renamed, never over IN.exr",
        [](Options& o, const std::string&, const std::string& v) { o.output = v; }},
-      {FrontOption::kInputOutput, "--camera", nullptr, "CAM.json",
+      {kInputOutput, "--camera", nullptr, "CAM.json",
        "camera description (required): Blender camera properties and matrix_world, see "
        "docs/conventions.md",
        [](Options& o, const std::string&, const std::string& v) { o.camera = v; }},
-      {FrontOption::kInputOutput, "--ao-only", nullptr, nullptr,
+      {kInputOutput, "--ao-only", nullptr, nullptr,
        "write exactly one channel, AO, instead of beauty x AO + AO",
        [](Options& o, const std::string&, const std::string&) { o.ao_only = true; }},
-      {FrontOption::kInputOutput, "--layer", nullptr, "NAME",
+      {kInputOutput, "--layer", nullptr, "NAME",
        "view layer to read when several have a Depth pass",
        [](Options& o, const std::string&, const std::string& v) { o.layer = v; }},
-      {FrontOption::kInputOutput, "--depth-channel", nullptr, "NAME",
+      {kInputOutput, "--depth-channel", nullptr, "NAME",
        "depth channel (default <layer>.Depth.Z, or Depth.Z, Z, depth, Depth without layers)",
        [](Options& o, const std::string&, const std::string& v) { o.depth_channel = v; }},
-      {FrontOption::kInputOutput, "--normal-channels", nullptr, "X,Y,Z",
+      {kInputOutput, "--normal-channels", nullptr, "X,Y,Z",
        "normal channels (default <layer>.Normal.X,Y,Z, or Normal.* / N.* without layers)",
        [](Options& o, const std::string& f, const std::string& v) {
          o.normal_channels = parse_channel_list(f, v, 3, 3);
        }},
-      {FrontOption::kInputOutput, "--beauty-channels", nullptr, "R,G,B[,A]",
+      {kInputOutput, "--beauty-channels", nullptr, "R,G,B[,A]",
        "beauty channels (default <layer>.Combined.R,G,B[,A], or Combined.* / R,G,B[,A])",
        [](Options& o, const std::string& f, const std::string& v) {
          o.beauty_channels = parse_channel_list(f, v, 3, 4);
        }},
-      {FrontOption::kInputOutput, "--no-normals", nullptr, nullptr,
+      {kInputOutput, "--no-normals", nullptr, nullptr,
        "ignore the normal pass; reconstruct normals from depth",
        [](Options& o, const std::string&, const std::string&) { o.no_normals = true; }},
-      {FrontOption::kOther, "--quiet", "-q", nullptr,
+      {kOther, "--quiet", "-q", nullptr,
        "no progress, no summary, no warnings (errors are still shown)",
        [](Options& o, const std::string&, const std::string&) { o.quiet = true; }},
-      {FrontOption::kOther, "--help", "-h", nullptr, "print this help and exit",
+      {kOther, "--help", "-h", nullptr, "print this help and exit",
        [](Options& o, const std::string&, const std::string&) { o.help = true; }},
-      {FrontOption::kOther, "--version", nullptr, nullptr, "print the library version and exit",
+      {kOther, "--version", nullptr, nullptr, "print the library version and exit",
        [](Options& o, const std::string&, const std::string&) { o.version = true; }},
   };
   return options;
-}
-
-const FrontOption* find_front_option(const std::string& flag) {
-  for (const FrontOption& option : front_options()) {
-    if (flag == option.flag || (option.alias && flag == option.alias)) return &option;
-  }
-  return nullptr;
 }
 
 void require_complete(const Options& options) {
@@ -98,14 +84,6 @@ void require_complete(const Options& options) {
   if (options.no_normals && !options.normal_channels.empty()) {
     throw UsageError("--no-normals and --normal-channels contradict each other");
   }
-}
-
-std::string unknown_option_message(const std::string& flag,
-                                   const std::vector<ssao_param_desc>& table) {
-  std::vector<std::string> known;
-  for (const FrontOption& option : front_options()) known.push_back(option.flag);
-  for (const ssao_param_desc& desc : table) known.push_back(flag_for(desc.name));
-  return ssao_io::unknown_option_message(flag, known);
 }
 
 }  // namespace
@@ -141,37 +119,7 @@ Options parse_args(int argc, const char* const* argv, const std::vector<ssao_par
       continue;
     }
 
-    // --flag=value or --flag value
-    std::string flag = arg;
-    std::string value;
-    bool has_inline_value = false;
-    const size_t equals = arg.find('=');
-    if (arg.rfind("--", 0) == 0 && equals != std::string::npos) {
-      flag = arg.substr(0, equals);
-      value = arg.substr(equals + 1);
-      has_inline_value = true;
-    }
-
-    const FrontOption* option = find_front_option(flag);
-    const ssao_param_desc* param = option ? nullptr : find_param(flag, table);
-    if (!option && !param) throw UsageError(unknown_option_message(flag, table));
-
-    const bool takes_value = param != nullptr || option->metavar != nullptr;
-    if (!takes_value) {
-      if (has_inline_value) throw UsageError(flag + " takes no value");
-      option->apply(out, option->flag, "");
-      continue;
-    }
-    if (!has_inline_value) {
-      if (i + 1 >= argc) throw UsageError(flag + " requires a value");
-      value = argv[++i];
-    }
-    if (param) {
-      out.params.push_back(parse_param(*param, flag, value));
-    } else {
-      if (value.empty()) throw UsageError(flag + " requires a non-empty value");
-      option->apply(out, option->flag, value);
-    }
+    ssao_io::parse_option(argc, argv, i, front_options(), table, out);
   }
   require_complete(out);
   return out;
@@ -188,8 +136,8 @@ std::string usage_text(const std::vector<ssao_param_desc>& table) {
       "\n"
       "Input and output:\n";
   text += help_entry("IN.exr", "input image (any file OpenImageIO reads)");
-  for (const FrontOption::Group group : {FrontOption::kInputOutput, FrontOption::kOther}) {
-    if (group == FrontOption::kOther) text += "\nOther:\n";
+  for (const Group group : {kInputOutput, kOther}) {
+    if (group == kOther) text += "\nOther:\n";
     for (const FrontOption& option : front_options()) {
       if (option.group != group) continue;
       std::string left =

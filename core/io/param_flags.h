@@ -84,4 +84,67 @@ std::string param_help(const std::vector<ssao_param_desc>& table, Predicate incl
   return text;
 }
 
+// An option of a front end itself (not a library parameter). Each front end keeps a table of
+// them, which drives its parsing, --help and "did you mean" suggestions. Options is the front
+// end's result type (with a `params` vector of ParamSetting); Group orders its --help.
+template <typename Options, typename Group>
+struct FrontOption {
+  Group group;
+  const char* flag;
+  const char* alias;    // short form or nullptr
+  const char* metavar;  // nullptr for a switch
+  const char* help;
+  void (*apply)(Options& out, const std::string& flag, const std::string& value);
+};
+
+// Parses the option at argv[i], written "--flag", "--flag=value" or "--flag value" (then i is
+// left on the value): a front option is applied to `out`, a library parameter is parsed into
+// out.params. Throws UsageError for an unknown flag (suggesting the closest), a missing value
+// or a value given to a switch.
+template <typename Options, typename Group>
+void parse_option(int argc, const char* const* argv, int& i,
+                  const std::vector<FrontOption<Options, Group>>& options,
+                  const std::vector<ssao_param_desc>& table, Options& out) {
+  const std::string arg = argv[i];
+  std::string flag = arg;
+  std::string value;
+  bool has_inline_value = false;
+  const size_t equals = arg.find('=');
+  if (arg.rfind("--", 0) == 0 && equals != std::string::npos) {
+    flag = arg.substr(0, equals);
+    value = arg.substr(equals + 1);
+    has_inline_value = true;
+  }
+  const FrontOption<Options, Group>* option = nullptr;
+  for (const auto& candidate : options) {
+    if (flag == candidate.flag || (candidate.alias && flag == candidate.alias)) {
+      option = &candidate;
+      break;
+    }
+  }
+  const ssao_param_desc* param = option ? nullptr : find_param(flag, table);
+  if (!option && !param) {
+    std::vector<std::string> known;
+    for (const auto& candidate : options) known.push_back(candidate.flag);
+    for (const ssao_param_desc& desc : table) known.push_back(flag_for(desc.name));
+    throw UsageError(unknown_option_message(flag, known));
+  }
+  const bool takes_value = param != nullptr || option->metavar != nullptr;
+  if (!takes_value) {
+    if (has_inline_value) throw UsageError(flag + " takes no value");
+    option->apply(out, option->flag, "");
+    return;
+  }
+  if (!has_inline_value) {
+    if (i + 1 >= argc) throw UsageError(flag + " requires a value");
+    value = argv[++i];
+  }
+  if (param) {
+    out.params.push_back(parse_param(*param, flag, value));
+  } else {
+    if (value.empty()) throw UsageError(flag + " requires a non-empty value");
+    option->apply(out, option->flag, value);
+  }
+}
+
 }  // namespace ssao_io
