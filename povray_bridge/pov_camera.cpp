@@ -93,22 +93,6 @@ const std::set<std::string>& unsupported_types() {
   return types;
 }
 
-bool is_punct(const Token& token, const char* text) {
-  return token.kind == Token::kPunct && token.text == text;
-}
-
-size_t skip_group(const std::vector<Token>& tokens, size_t open) {
-  const std::string opening = tokens[open].text;
-  const std::string closing = opening == "{" ? "}" : opening == "(" ? ")" : "]";
-  int depth = 0;
-  for (size_t i = open; i < tokens.size(); ++i) {
-    if (tokens[i].kind != Token::kPunct) continue;
-    if (tokens[i].text == opening) ++depth;
-    if (tokens[i].text == closing && --depth == 0) return i + 1;
-  }
-  return tokens.size() - 1;
-}
-
 const std::set<std::string>& modifier_keywords() {
   static const std::set<std::string> words = {
       "location", "look_at",      "angle",       "right",      "up",       "direction",

@@ -217,10 +217,6 @@ const std::set<std::string>& camera_keywords() {
   return words;
 }
 
-bool is_punct(const Token& token, const char* text) {
-  return token.kind == Token::kPunct && token.text == text;
-}
-
 std::string describe(const Token& token) {
   switch (token.kind) {
     case Token::kEnd:
@@ -620,20 +616,6 @@ bool starts_expression(const std::vector<Token>& tokens, size_t pos) {
 
 namespace {
 
-// Index of the token after the group that opens at tokens[open] ('{', '(' or '['), matching
-// the same kind of bracket; tokens.size() - 1 (kEnd) if unbalanced.
-size_t skip_group(const std::vector<Token>& tokens, size_t open) {
-  const std::string opening = tokens[open].text;
-  const std::string closing = opening == "{" ? "}" : opening == "(" ? ")" : "]";
-  int depth = 0;
-  for (size_t i = open; i < tokens.size(); ++i) {
-    if (tokens[i].kind != Token::kPunct) continue;
-    if (tokens[i].text == opening) ++depth;
-    if (tokens[i].text == closing && --depth == 0) return i + 1;
-  }
-  return tokens.size() - 1;
-}
-
 // The index after the parenthesised argument of a directive at tokens[i] (if any).
 size_t after_argument(const std::vector<Token>& tokens, size_t i) {
   return is_punct(tokens[i + 1], "(") ? skip_group(tokens, i + 1) : i + 1;
@@ -1012,6 +994,22 @@ SceneScan scan_scene(const std::string& path, const ScanSettings& settings) {
   scanner.result.clock = settings.clock;
   scanner.scan_file(path, fs::path(path).filename().string(), 0);
   return scanner.result;
+}
+
+bool is_punct(const Token& token, const char* text) {
+  return token.kind == Token::kPunct && token.text == text;
+}
+
+size_t skip_group(const std::vector<Token>& tokens, size_t open) {
+  const std::string opening = tokens[open].text;
+  const std::string closing = opening == "{" ? "}" : opening == "(" ? ")" : "]";
+  int depth = 0;
+  for (size_t i = open; i < tokens.size(); ++i) {
+    if (tokens[i].kind != Token::kPunct) continue;
+    if (tokens[i].text == opening) ++depth;
+    if (tokens[i].text == closing && --depth == 0) return i + 1;
+  }
+  return tokens.size() - 1;
 }
 
 }  // namespace povray_ssao

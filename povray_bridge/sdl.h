@@ -57,6 +57,13 @@ struct Token {
 // token is kEnd. Throws ssao_io::Error for an unterminated string or comment.
 std::vector<Token> tokenize(const std::string& text, const std::string& file);
 
+// True if `token` is the punctuation `text`.
+bool is_punct(const Token& token, const char* text);
+
+// Index of the token after the group that opens at tokens[open] ('{', '(' or '['), matching
+// the same kind of bracket; tokens.size() - 1 (kEnd) if unbalanced.
+size_t skip_group(const std::vector<Token>& tokens, size_t open);
+
 // "scene.pov:12"
 std::string where(const Token& token);
 
