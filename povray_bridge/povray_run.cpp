@@ -170,16 +170,30 @@ std::string povray_error_lines(const std::string& log_path, size_t max_lines) {
   return out;
 }
 
-void ini_size(const std::string& path, int& width, int& height) {
+namespace {
+
+// The lines POV-Ray reads from an INI file: comments (';') stripped, trimmed, empty lines
+// dropped, up to the first named section (POV-Ray reads only the unnamed one by default).
+std::vector<std::string> ini_lines(const std::string& path, bool required) {
   std::ifstream file(path);
-  if (!file) throw ssao_io::Error("cannot read the INI file '" + path + "'");
+  if (!file && required) throw ssao_io::Error("cannot read the INI file '" + path + "'");
+  std::vector<std::string> lines;
   std::string line;
   while (std::getline(file, line)) {
     const size_t comment = line.find(';');
     if (comment != std::string::npos) line.resize(comment);
     line = trim(line);
     if (line.empty()) continue;
-    if (line[0] == '[') break;  // POV-Ray reads only the unnamed section by default
+    if (line[0] == '[') break;
+    lines.push_back(line);
+  }
+  return lines;
+}
+
+}  // namespace
+
+void ini_size(const std::string& path, int& width, int& height) {
+  for (const std::string& line : ini_lines(path, true)) {
     if ((line[0] == '+' || line[0] == '-') && line.size() > 2) {
       // Switches, possibly several on one line.
       std::stringstream words(line);
@@ -203,14 +217,7 @@ void ini_size(const std::string& path, int& width, int& height) {
 }
 
 void ini_library_paths(const std::string& path, std::vector<std::string>& paths) {
-  std::ifstream file(path);
-  std::string line;
-  while (std::getline(file, line)) {
-    const size_t comment = line.find(';');
-    if (comment != std::string::npos) line.resize(comment);
-    line = trim(line);
-    if (line.empty()) continue;
-    if (line[0] == '[') break;
+  for (const std::string& line : ini_lines(path, false)) {
     std::string value;
     if ((line[0] == '+' || line[0] == '-') && line.size() > 2 &&
         std::toupper(static_cast<unsigned char>(line[1])) == 'L') {
@@ -251,14 +258,7 @@ void declare_option(const std::string& text, std::vector<std::string>& declares,
 }  // namespace
 
 void ini_declares(const std::string& path, std::vector<std::string>& declares, double& clock) {
-  std::ifstream file(path);
-  std::string line;
-  while (std::getline(file, line)) {
-    const size_t comment = line.find(';');
-    if (comment != std::string::npos) line.resize(comment);
-    line = trim(line);
-    if (line.empty()) continue;
-    if (line[0] == '[') break;
+  for (const std::string& line : ini_lines(path, false)) {
     if (line[0] == '+' || line[0] == '-') {
       std::stringstream words(line);
       std::string word;
