@@ -90,17 +90,7 @@ void require_complete(const Options& options) {
 
 Options parse_args(int argc, const char* const* argv, const std::vector<ssao_param_desc>& table) {
   Options out;
-  for (int i = 1; i < argc; ++i) {
-    const std::string arg = argv[i];
-    if (arg == "--help" || arg == "-h") {
-      out.help = true;
-      return out;
-    }
-    if (arg == "--version") {
-      out.version = true;
-      return out;
-    }
-  }
+  if (ssao_io::scan_help_and_version(argc, argv, out)) return out;
 
   bool only_positionals = false;
   for (int i = 1; i < argc; ++i) {

@@ -97,6 +97,24 @@ struct FrontOption {
   void (*apply)(Options& out, const std::string& flag, const std::string& value);
 };
 
+// Sets out.help (for --help or -h) or out.version (--version) when either appears anywhere on
+// the command line, which then means nothing else; returns whether one did.
+template <typename Options>
+bool scan_help_and_version(int argc, const char* const* argv, Options& out) {
+  for (int i = 1; i < argc; ++i) {
+    const std::string arg = argv[i];
+    if (arg == "--help" || arg == "-h") {
+      out.help = true;
+      return true;
+    }
+    if (arg == "--version") {
+      out.version = true;
+      return true;
+    }
+  }
+  return false;
+}
+
 // Parses the option at argv[i], written "--flag", "--flag=value" or "--flag value" (then i is
 // left on the value): a front option is applied to `out`, a library parameter is parsed into
 // out.params. Throws UsageError for an unknown flag (suggesting the closest), a missing value
