@@ -27,6 +27,9 @@ import unittest
 import numpy as np
 import OpenImageIO as oiio
 
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
+from image_files import read_image  # noqa: E402
+
 SSAO = os.environ.get("SSAO_CLI", "")
 LIB = os.environ.get("SSAO_LIB", "")
 SCRATCH = os.environ.get("SSAO_SCRATCH", "")
@@ -98,18 +101,6 @@ def write_exr(path, planes, names=None):
     assert out.open(path, spec), out.geterror()
     assert out.write_image(pixels), out.geterror()
     out.close()
-
-
-def read_exr(path):
-    """Returns (channel names, float32 array HEIGHT x WIDTH x channels). ImageInput, not
-    ImageBuf: ImageBuf's cache would return stale pixels for a file rewritten under one name."""
-    inp = oiio.ImageInput.open(path)
-    assert inp is not None, oiio.geterror()
-    spec = inp.spec()
-    pixels = inp.read_image(oiio.FLOAT)
-    assert pixels is not None, inp.geterror()
-    inp.close()
-    return list(spec.channelnames), pixels.reshape(spec.height, spec.width, spec.nchannels)
 
 
 def dump_core_table(lib_path):
@@ -200,7 +191,7 @@ class GoodRunTest(CliTestCase):
     def test_composite_is_beauty_times_ao(self):
         proc = self.run_ssao()
         self.assert_ok(proc)
-        names, out = read_exr(self.output)
+        names, out = read_image(self.output)
         self.assertEqual(sorted(names), ["A", "AO", "B", "G", "R"])
         ao = out[:, :, names.index("AO")]
         self.assertTrue(np.all(np.isfinite(ao)))
@@ -232,44 +223,44 @@ class GoodRunTest(CliTestCase):
 
     def test_ao_only_writes_one_channel(self):
         self.assert_ok(self.run_ssao("--ao-only"))
-        names, out = read_exr(self.output)
+        names, out = read_image(self.output)
         self.assertEqual(names, ["AO"])
         self.assertEqual(out.shape, (HEIGHT, WIDTH, 1))
         np.testing.assert_allclose(out[:SKY_ROWS, :, 0], 1.0, rtol=0, atol=1e-6)
 
     def test_ao_only_matches_composite_run(self):
         self.assert_ok(self.run_ssao())
-        names, full = read_exr(self.output)
+        names, full = read_image(self.output)
         os.remove(self.output)
         self.assert_ok(self.run_ssao("--ao-only"))
-        _, ao_only = read_exr(self.output)
+        _, ao_only = read_image(self.output)
         np.testing.assert_array_equal(ao_only[:, :, 0], full[:, :, names.index("AO")])
 
     def test_without_alpha_writes_rgb_and_ao(self):
         write_exr(self.input, self.planes,
                   [n for n in BLENDER_CHANNELS if n != "ViewLayer.Combined.A"])
         self.assert_ok(self.run_ssao())
-        names, _ = read_exr(self.output)
+        names, _ = read_image(self.output)
         self.assertEqual(sorted(names), ["AO", "B", "G", "R"])
 
     def test_result_does_not_depend_on_thread_count(self):
         self.assert_ok(self.run_ssao("--ao-only", "--threads", "1"))
-        _, one = read_exr(self.output)
+        _, one = read_image(self.output)
         os.remove(self.output)
         self.assert_ok(self.run_ssao("--ao-only", "--threads", "3"))
-        _, three = read_exr(self.output)
+        _, three = read_image(self.output)
         np.testing.assert_array_equal(one, three)
 
     def test_strength_zero_gives_no_occlusion(self):
         self.assert_ok(self.run_ssao("--ao-only", "--strength", "0"))
-        _, off = read_exr(self.output)
+        _, off = read_image(self.output)
         np.testing.assert_allclose(off, 1.0, rtol=0, atol=1e-6)
 
     def test_no_normals_reconstructs_from_depth(self):
         proc = self.run_ssao("--ao-only", "--no-normals")
         self.assert_ok(proc)
         self.assertIn("normals from depth", proc.stderr)
-        _, out = read_exr(self.output)
+        _, out = read_image(self.output)
         self.assertTrue(np.all(np.isfinite(out)))
         np.testing.assert_allclose(out[:SKY_ROWS, :, 0], 1.0, rtol=0, atol=1e-6)
 
@@ -283,7 +274,7 @@ class GoodRunTest(CliTestCase):
         with open(self.output, "w") as f:
             f.write("old")
         self.assert_ok(self.run_ssao("--ao-only"))
-        self.assertEqual(read_exr(self.output)[0], ["AO"])
+        self.assertEqual(read_image(self.output)[0], ["AO"])
 
     def test_explicit_channels_and_single_layer_file(self):
         names = {"ViewLayer.Depth.Z": "Z", "ViewLayer.Combined.R": "R",
@@ -292,7 +283,7 @@ class GoodRunTest(CliTestCase):
                  "ViewLayer.Normal.Z": "N.Z"}
         write_exr(self.input, {names[k]: v for k, v in self.planes.items() if k in names})
         self.assert_ok(self.run_ssao())
-        got, _ = read_exr(self.output)
+        got, _ = read_image(self.output)
         self.assertEqual(sorted(got), ["AO", "B", "G", "R"])
         os.remove(self.output)
         self.assert_ok(self.run_ssao("--depth-channel", "Z", "--normal-channels", "N.X,N.Y,N.Z",
@@ -318,7 +309,7 @@ class BackgroundDepthTest(CliTestCase):
         write_exr(self.input, self.planes, BLENDER_CHANNELS)
         proc = self.run_ssao()
         self.assert_ok(proc)
-        names, out = read_exr(self.output)
+        names, out = read_image(self.output)
         ao = out[:, :, names.index("AO")]
         self.assertTrue(np.all(np.isfinite(ao)), "AO has non-finite values")
         for (y, x) in bad:
@@ -329,7 +320,7 @@ class BackgroundDepthTest(CliTestCase):
         camera = dict(CAMERA, clip_end=9.0)  # the wall (10) is now beyond clip_end
         self.camera = self.write_camera(camera)
         self.assert_ok(self.run_ssao("--ao-only"))
-        _, out = read_exr(self.output)
+        _, out = read_image(self.output)
         wall = self.planes["ViewLayer.Depth.Z"] == WALL_DEPTH
         np.testing.assert_allclose(out[:, :, 0][wall], 1.0, rtol=0, atol=1e-6)
 
@@ -365,7 +356,7 @@ class HelpTest(CliTestCase):
         for name, value in values.items():
             args += ["--" + name.replace("_", "-"), value]
         self.assert_ok(self.run_ssao("--ao-only", *args))
-        _, out = read_exr(self.output)
+        _, out = read_image(self.output)
         geometry = out[SKY_ROWS:, :, 0]  # the sky stays at 1 whatever the remapping
         self.assertTrue(np.all((geometry >= 0.1 - 1e-6) & (geometry <= 0.9 + 1e-6)))
 

@@ -27,7 +27,9 @@ import tempfile
 import unittest
 
 import numpy as np
-import OpenImageIO as oiio
+
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
+from image_files import read_image  # noqa: E402
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 SCENES = os.path.join(HERE, "scenes")
@@ -52,19 +54,6 @@ AN_DISC_RADIUS = 8.0
 
 # ----------------------------------------------------------------------------------------------
 # Images and POV-Ray's camera model
-
-def read_image(path):
-    """(channel names, float32 array height x width x channels). ImageInput, not ImageBuf (its
-    cache would return stale pixels for a file rewritten under one name)."""
-    inp = oiio.ImageInput.open(path)
-    assert inp is not None, oiio.geterror()
-    spec = inp.spec()
-    pixels = inp.read_image(oiio.FLOAT)
-    assert pixels is not None, inp.geterror()
-    inp.close()
-    return list(spec.channelnames), np.asarray(pixels, np.float32).reshape(
-        spec.height, spec.width, spec.nchannels)
-
 
 def channel(names, pixels, name):
     assert name in names, f"no channel {name} in {names}"
