@@ -9,6 +9,7 @@ PACKAGES=(
   libopenimageio-dev openimageio-tools      # EXR I/O of the command-line tool
   libopenexr-dev nlohmann-json3-dev
   python3-numpy python3-openimageio         # Python test helpers (/usr/bin/python3)
+  python3-matplotlib                        # benchmark plots (scripts/benchmark.sh)
   blender                                   # ground truth renders (Cycles AO pass)
   povray povray-examples                    # the POV-Ray bridge and its test scenes
   debootstrap                               # Blender 4.3 tests (a Debian 13 folder)

@@ -165,7 +165,7 @@ def add_box(scene, name, size, center, material, rotation_z_deg=0.0):
     return add_mesh_object(scene, name, verts, faces, material)
 
 
-def add_sphere(scene, name, radius, center, material, segments=48, rings=24):
+def add_sphere(scene, name, radius, center, material, segments=48, rings=24, smooth=True):
     mesh = bpy.data.meshes.new(name)
     bm = bmesh.new()
     # bmesh's create_uvsphere takes 'radius' since Blender 3.0 ('diameter' before).
@@ -174,7 +174,7 @@ def add_sphere(scene, name, radius, center, material, segments=48, rings=24):
     bm.to_mesh(mesh)
     bm.free()
     for poly in mesh.polygons:
-        poly.use_smooth = True
+        poly.use_smooth = smooth
     mesh.materials.append(material)
     obj = bpy.data.objects.new(name, mesh)
     scene.collection.objects.link(obj)
@@ -234,27 +234,28 @@ def add_sun(scene):
     return obj
 
 
-def add_camera(scene, kind):
+def add_camera(scene, kind, location=CAMERA_LOCATION, target=CAMERA_TARGET, lens=CAMERA_LENS,
+               clip=CAMERA_CLIP, ortho_scale=None):
+    """The scene's camera at `location` looking at `target`. An orthographic camera shows, by
+    default, what the perspective one shows at the target's distance."""
     cam = bpy.data.cameras.new("Camera")
-    cam.lens = CAMERA_LENS
+    cam.lens = lens
     cam.sensor_width = CAMERA_SENSOR_WIDTH
     cam.sensor_fit = "AUTO"
     cam.shift_x = 0.0
     cam.shift_y = 0.0
-    cam.clip_start, cam.clip_end = CAMERA_CLIP
-    distance = (CAMERA_TARGET - CAMERA_LOCATION).length
+    cam.clip_start, cam.clip_end = clip
+    location, target = Vector(location), Vector(target)
+    direction = target - location
     if kind == "ortho":
         cam.type = "ORTHO"
-        # The perspective camera's view at the target distance: with sensor fit
-        # AUTO the sensor width spans the larger image side.
-        fit = cam.sensor_width / cam.lens
-        cam.ortho_scale = distance * fit
+        # With sensor fit AUTO the sensor width spans the larger image side.
+        cam.ortho_scale = ortho_scale or direction.length * cam.sensor_width / cam.lens
     else:
         cam.type = "PERSP"
     obj = bpy.data.objects.new("Camera", cam)
-    direction = CAMERA_TARGET - CAMERA_LOCATION
     rot = direction.to_track_quat("-Z", "Y").to_matrix().to_4x4()
-    obj.matrix_world = Matrix.Translation(CAMERA_LOCATION) @ rot
+    obj.matrix_world = Matrix.Translation(location) @ rot
     scene.collection.objects.link(obj)
     scene.camera = obj
     return obj
@@ -293,7 +294,13 @@ def configure_render(scene, args, exr_path):
     r.pixel_aspect_x = 1.0
     r.pixel_aspect_y = 1.0
     r.film_transparent = False
-    r.use_border = False
+    # --border: render a region only (the rest of the image stays empty), for a second render
+    # that measures the reference's own noise at a fraction of the cost.
+    border = getattr(args, "border", None)
+    r.use_border = border is not None
+    if border is not None:
+        r.border_min_x, r.border_max_x, r.border_min_y, r.border_max_y = border
+        r.use_crop_to_border = False
     r.threads_mode = "FIXED"
     r.threads = args.threads
     # Write the render result itself: no compositing, no sequencer.
@@ -366,28 +373,19 @@ def write_json(path, data):
     os.replace(tmp, path)
 
 
-def main():
-    args = parse_args(script_argv())
-    prefix = os.path.abspath(args.out)
+def render_reference(scene, cam_obj, args, prefix, scene_name, extra_meta=None):
+    """Renders `scene` with the passes of args into PREFIX.exr and writes PREFIX.camera.json
+    and PREFIX.json (metadata, plus `extra_meta`)."""
     out_dir = os.path.dirname(prefix)
     os.makedirs(out_dir, exist_ok=True)
     exr_path = prefix + ".exr"
     camera_path = prefix + ".camera.json"
     meta_path = prefix + ".json"
-    scene_name = args.scene_name or os.path.basename(prefix)
-
     for path in (exr_path, camera_path, meta_path):
         if os.path.exists(path):
             os.remove(path)
 
-    scene = bpy.context.scene
-    clear_scene(scene)
-    build_geometry(scene)
-    setup_world(scene, args.ao_distance)
-    add_sun(scene)
-    cam_obj = add_camera(scene, args.camera)
     scene.frame_set(1)
-
     ENGINES[args.engine](scene, args)
     layer = configure_render(scene, args, exr_path)
     if bpy.context.view_layer is not None:
@@ -426,6 +424,7 @@ def main():
         "blender_version": bpy.app.version_string,
         "projection": matrix_rows(projection),
     }
+    meta.update(extra_meta or {})
     write_json(meta_path, meta)
 
     print("make_reference_scene: wrote %s (%dx%d, %d spp, %s %s, passes %s, "
@@ -433,6 +432,18 @@ def main():
           % (exr_path, args.width, args.height, args.samples, args.engine,
              camera["type"], "+".join(passes), args.ao_distance, render_seconds,
              os.path.getsize(exr_path)))
+
+
+def main():
+    args = parse_args(script_argv())
+    prefix = os.path.abspath(args.out)
+    scene = bpy.context.scene
+    clear_scene(scene)
+    build_geometry(scene)
+    setup_world(scene, args.ao_distance)
+    add_sun(scene)
+    cam_obj = add_camera(scene, args.camera)
+    render_reference(scene, cam_obj, args, prefix, args.scene_name or os.path.basename(prefix))
 
 
 if __name__ == "__main__":

@@ -1,15 +1,18 @@
 // SPDX-License-Identifier: MIT
-// ssao_eval: scores an AO method against the ray-traced AO pass of a Blender render.
+// ssao_eval: scores AO methods against the ray-traced AO pass of a Blender render.
 //
 //   ssao_eval SCENE.exr --camera CAM.json --radius R --method M [options]
+//   ssao_eval SCENE.exr --camera CAM.json --radius R --run "M NAME=VALUE ..." --run ... [options]
 //
-// Methods: "ssao" (libssao through the C API, configured with --set name=value), and the
+// Methods: "ssao" (libssao through the C API, configured with --set name=value), the
 // references of tests/reference: "seed-hemisphere", "seed-sphere" (ports of the seed tutorials'
-// code) and "raymarch" (brute-force depth-buffer ray march). The score is the RMSE and the mean
-// signed error (method - truth) of the AO over the pixels whose depth is finite, > 0 and
-// < 0.9 * clip_end, against the file's "<layer>.AO.R" channel (Cycles' AO pass). Run with --help
-// for the options. Exit status: 0 success, 1 a failed check (--max-rmse, --compare-to) or an
-// unreadable input, 2 a command-line mistake.
+// code) and "raymarch" (brute-force depth-buffer ray march), and "image" (an AO image from a
+// file, such as Cycles' AO pass at fewer samples: scored, not timed). The score is the RMSE and
+// the mean signed error (method - truth) of the AO over the pixels whose depth is finite, > 0
+// and < 0.9 * clip_end, against the file's "<layer>.AO.R" channel (Cycles' AO pass). Several
+// methods are timed in interleaved rounds (A B A B ...), so that their ratios share the
+// machine's moods. Run with --help for the options. Exit status: 0 success, 1 a failed check
+// (--max-rmse, --compare-to) or an unreadable input, 2 a command-line mistake.
 #include <algorithm>
 #include <array>
 #include <cerrno>
@@ -50,14 +53,16 @@ class UsageError : public std::runtime_error {
 
 const char* const kUsage =
     "Usage: ssao_eval SCENE.exr --camera CAM.json --radius R --method M [options]\n"
+    "       ssao_eval SCENE.exr --camera CAM.json --radius R --run \"M NAME=VALUE ...\" ...\n"
     "\n"
-    "Scores an AO method against the ray-traced AO pass (<layer>.AO.R) of a Blender multilayer\n"
+    "Scores AO methods against the ray-traced AO pass (<layer>.AO.R) of a Blender multilayer\n"
     "EXR with Depth (and optionally Normal) passes. Prints one line per method:\n"
     "  scene=... method=... settings=... normals=pass|depth rmse=... mean_error=... time_ms=...\n"
-    "  repeat=N threads=T pixels=P\n"
+    "  min_ms=... repeat=N threads=T pixels=P\n"
     "over the pixels whose depth is finite, > 0 and < 0.9 * clip_end. mean_error is the mean\n"
-    "of (method - truth): positive means too little occlusion. time_ms is the best of --repeat\n"
-    "runs of the AO computation alone (no file I/O).\n"
+    "of (method - truth): positive means too little occlusion. time_ms is the median of\n"
+    "--repeat runs of the AO computation alone (no file I/O), min_ms the fastest; the methods\n"
+    "run in interleaved rounds (A B C A B C ...). An image method is not timed (nan).\n"
     "\n"
     "Methods:\n"
     "  ssao             libssao through its C API; world-space normals from the Normal pass\n"
@@ -68,13 +73,20 @@ const char* const kUsage =
     "  seed-sphere      port of the seed Crysis sphere code (--set samples=N, seed=N)\n"
     "  raymarch         brute-force ray march through the depth buffer (--set rays=N,\n"
     "                   steps=N, thickness=F (fraction of radius), seed=N)\n"
+    "  image            an AO image from a file, e.g. Cycles' AO pass at fewer samples\n"
+    "                   (--set path=FILE; channel=NAME, default <layer>.AO.R or AO;\n"
+    "                   region=MIN_X,MAX_X,MIN_Y,MAX_Y scores only that part of the frame, in\n"
+    "                   fractions measured from the bottom left, as Blender's render border)\n"
     "\n"
     "Options:\n"
     "  --camera FILE        camera JSON (required)\n"
     "  --radius R           AO distance in scene units, as Cycles' (required)\n"
     "  --method M           method to score (required)\n"
     "  --set NAME=VALUE     parameter of the method (repeatable); arrays as a,b,c\n"
-    "  --repeat N           time N runs and report the fastest (default 1)\n"
+    "  --run \"M N=V ...\"    one more method with its parameters, separated by spaces\n"
+    "                       (repeatable; the first --run is the method when --method is not\n"
+    "                       given)\n"
+    "  --repeat N           time N runs of each method, report the median (default 1)\n"
     "  --max-rmse X         exit 1 if the RMSE is above X\n"
     "  --compare-to M2      also score M2 (with its defaults and --compare-set) and exit 1\n"
     "                       unless RMSE(M) < RMSE(M2) * (1 - margin)\n"
@@ -92,12 +104,21 @@ struct Setting {
   std::string value;
 };
 
+// A method to run and its settings.
+struct RunSpec {
+  std::string method;
+  std::vector<Setting> settings;
+  std::string flag = "--run";  // where the settings came from, for messages
+};
+
 struct Options {
   std::string scene;
   std::string camera;
   double radius = 0.0;
   std::string method;
   std::vector<Setting> settings;
+  std::string method_flag = "--set";  // the option that gave the method's settings
+  std::vector<RunSpec> more_runs;     // --run, after the --method one
   int repeat = 1;
   bool has_max_rmse = false;
   double max_rmse = 0.0;
@@ -112,7 +133,7 @@ struct Options {
 
 const std::vector<std::string>& method_names() {
   static const std::vector<std::string> names = {"ssao", "seed-hemisphere", "seed-sphere",
-                                                 "raymarch"};
+                                                 "raymarch", "image"};
   return names;
 }
 
@@ -210,6 +231,14 @@ Options parse_args(int argc, char** argv) {
       check_method(o.method, "--method");
     } else if (arg == "--set") {
       o.settings.push_back(parse_setting(value(), "--set"));
+    } else if (arg == "--run") {
+      std::istringstream words(value());
+      RunSpec run;
+      std::string word;
+      if (!(words >> run.method)) throw UsageError("--run needs a method");
+      check_method(run.method, "--run");
+      while (words >> word) run.settings.push_back(parse_setting(word, "--run"));
+      o.more_runs.push_back(run);
     } else if (arg == "--repeat") {
       o.repeat = static_cast<int>(parse_integer(value(), "--repeat", 1, 1000));
     } else if (arg == "--max-rmse") {
@@ -243,7 +272,14 @@ Options parse_args(int argc, char** argv) {
   o.scene = positional.front();
   if (o.camera.empty()) throw UsageError("--camera CAM.json is required");
   if (!has_radius) throw UsageError("--radius R is required");
-  if (o.method.empty()) throw UsageError("--method M is required");
+  if (o.method.empty()) {
+    if (o.more_runs.empty()) throw UsageError("--method M is required (or give --run)");
+    if (!o.settings.empty()) throw UsageError("--set needs --method (use --run \"M N=V\")");
+    o.method = o.more_runs.front().method;
+    o.settings = o.more_runs.front().settings;
+    o.method_flag = "--run";
+    o.more_runs.erase(o.more_runs.begin());
+  }
   if (o.compare_to.empty() && !o.compare_settings.empty()) {
     throw UsageError("--compare-set needs --compare-to");
   }
@@ -415,14 +451,87 @@ ssao_ref::DepthScene reference_scene(const Scene& s) {
   return d;
 }
 
-// A method ready to run: run() writes the AO (1 channel, top row first) into *ao.
+// The part of the frame that is scored: columns [x0, x1), rows [y0, y1), top row 0.
+struct Window {
+  int x0 = 0, x1 = std::numeric_limits<int>::max();
+  int y0 = 0, y1 = std::numeric_limits<int>::max();
+};
+
+// A method ready to run: run() writes the AO (1 channel, top row first) into *ao. An untimed
+// method (an image from a file) has its AO from the start and no run().
 struct Method {
   std::string name;
   std::string settings;  // "name=value,..." as reported
   int threads = 1;
   std::shared_ptr<std::vector<float>> ao = std::make_shared<std::vector<float>>();
   std::function<void()> run;
+  Window window;
 };
+
+// The "image" method: settings path=FILE, channel=NAME, region=MIN_X,MAX_X,MIN_Y,MAX_Y
+// (fractions from the bottom left, Blender's render border; the edge pixels are left out).
+Method make_image_method(const std::vector<Setting>& settings, const std::string& flag,
+                         const Scene* scene) {
+  Method m;
+  m.name = "image";
+  m.threads = 0;
+  std::string path, channel;
+  std::vector<double> region;
+  for (const Setting& s : settings) {
+    const std::string where = flag + " " + s.name + "=" + s.value;
+    if (s.name == "path") {
+      path = s.value;
+    } else if (s.name == "channel") {
+      channel = s.value;
+    } else if (s.name == "region") {
+      std::stringstream list(s.value);
+      std::string item;
+      while (std::getline(list, item, ',')) region.push_back(parse_double(item, where));
+      if (region.size() != 4 || region[0] >= region[1] || region[2] >= region[3] ||
+          *std::min_element(region.begin(), region.end()) < 0.0 ||
+          *std::max_element(region.begin(), region.end()) > 1.0) {
+        throw UsageError(where + ": expected MIN_X,MAX_X,MIN_Y,MAX_Y, fractions in [0, 1]");
+      }
+    } else {
+      throw UsageError(where + ": method image has no parameter '" + s.name +
+                       "' (its parameters: path, channel, region)");
+    }
+  }
+  if (path.empty()) throw UsageError(flag + " image: path=FILE is required");
+  m.settings = "path=" + path;
+  if (scene == nullptr) return m;
+
+  const ssao_io::Image image = ssao_io::read_image(path);
+  if (image.width != scene->width || image.height != scene->height) {
+    throw ssao_io::Error("'" + path + "' is " + std::to_string(image.width) + "x" +
+                         std::to_string(image.height) + ", the scene " +
+                         std::to_string(scene->width) + "x" + std::to_string(scene->height));
+  }
+  int index = -1;
+  if (!channel.empty()) {
+    index = ssao_io::require_channel(image, channel, path);
+  } else {
+    for (int c = 0; c < image.channels() && index < 0; ++c) {
+      const std::string& name = image.channel_names[static_cast<size_t>(c)];
+      if (name == "AO" || (name.size() > 5 && name.compare(name.size() - 5, 5, ".AO.R") == 0)) {
+        index = c;
+      }
+    }
+    if (index < 0) {
+      throw ssao_io::Error("'" + path + "' has no channel AO or <layer>.AO.R; its channels: " +
+                           ssao_io::join_names(image.channel_names));
+    }
+  }
+  *m.ao = ssao_io::extract_channels(image, {index});
+  if (!region.empty()) {
+    const double w = scene->width, h = scene->height;
+    m.window.x0 = static_cast<int>(std::ceil(region[0] * w)) + 1;
+    m.window.x1 = static_cast<int>(std::floor(region[1] * w)) - 1;
+    m.window.y0 = static_cast<int>(std::ceil((1.0 - region[3]) * h)) + 1;
+    m.window.y1 = static_cast<int>(std::floor((1.0 - region[2]) * h)) - 1;
+  }
+  return m;
+}
 
 // The reference methods' settings: name -> value, checked against the allowed names.
 struct ReferenceSettings {
@@ -473,6 +582,7 @@ struct CoreState {
 // (so that command-line mistakes are found before any file is read).
 Method make_method(const std::string& name, const std::vector<Setting>& settings,
                    const std::string& flag, const Scene* scene, double radius) {
+  if (name == "image") return make_image_method(settings, flag, scene);
   Method m;
   m.name = name;
   if (name == "ssao") {
@@ -544,47 +654,68 @@ Method make_method(const std::string& name, const std::vector<Setting>& settings
   return m;
 }
 
-// Best wall time of `repeat` runs, in milliseconds.
-double time_runs(const Method& m, int repeat) {
-  double best = std::numeric_limits<double>::infinity();
-  for (int i = 0; i < repeat; ++i) {
-    const auto start = std::chrono::steady_clock::now();
-    m.run();
-    const auto stop = std::chrono::steady_clock::now();
-    best = std::min(best, std::chrono::duration<double, std::milli>(stop - start).count());
+// Wall times in milliseconds of `repeat` runs of every timed method, in interleaved rounds.
+std::vector<std::vector<double>> time_interleaved(const std::vector<Method>& methods, int repeat) {
+  std::vector<std::vector<double>> times(methods.size());
+  for (int round = 0; round < repeat; ++round) {
+    for (size_t i = 0; i < methods.size(); ++i) {
+      if (!methods[i].run) continue;
+      const auto start = std::chrono::steady_clock::now();
+      methods[i].run();
+      const auto stop = std::chrono::steady_clock::now();
+      times[i].push_back(std::chrono::duration<double, std::milli>(stop - start).count());
+    }
   }
-  return best;
+  return times;
+}
+
+double median(std::vector<double> values) {
+  if (values.empty()) return std::numeric_limits<double>::quiet_NaN();
+  std::sort(values.begin(), values.end());
+  const size_t n = values.size();
+  return n % 2 ? values[n / 2] : 0.5 * (values[n / 2 - 1] + values[n / 2]);
 }
 
 struct Score {
   double rmse = 0.0;
   double mean_error = 0.0;
+  size_t pixels = 0;
 };
 
-Score score(const Scene& s, const std::vector<float>& ao) {
+Score score(const Scene& s, const Method& m) {
+  const std::vector<float>& ao = *m.ao;
   if (ao.size() != s.truth.size()) {
     throw std::logic_error("AO of " + std::to_string(ao.size()) + " pixels, expected " +
                            std::to_string(s.truth.size()));
   }
+  Score sc;
   double sum = 0.0, sum_sq = 0.0;
-  for (size_t p = 0; p < ao.size(); ++p) {
-    if (!s.mask[p]) continue;
-    const double diff = static_cast<double>(ao[p]) - static_cast<double>(s.truth[p]);
-    sum += diff;
-    sum_sq += diff * diff;
+  for (int y = std::max(0, m.window.y0); y < std::min(s.height, m.window.y1); ++y) {
+    for (int x = std::max(0, m.window.x0); x < std::min(s.width, m.window.x1); ++x) {
+      const size_t p = static_cast<size_t>(y) * static_cast<size_t>(s.width) + x;
+      if (!s.mask[p]) continue;
+      const double diff = static_cast<double>(ao[p]) - static_cast<double>(s.truth[p]);
+      sum += diff;
+      sum_sq += diff * diff;
+      ++sc.pixels;
+    }
   }
-  const double n = static_cast<double>(s.scored);
-  return {std::sqrt(sum_sq / n), sum / n};
+  if (sc.pixels == 0) throw ssao_io::Error(m.name + " " + m.settings + ": no pixel to score");
+  const double n = static_cast<double>(sc.pixels);
+  sc.rmse = std::sqrt(sum_sq / n);
+  sc.mean_error = sum / n;
+  return sc;
 }
 
-Score evaluate(const Scene& s, const Options& o, const Method& m) {
-  const double ms = time_runs(m, o.repeat);
-  const Score sc = score(s, *m.ao);
+Score report(const Scene& s, const Options& o, const Method& m, const std::vector<double>& ms) {
+  const Score sc = score(s, m);
+  const double min_ms = ms.empty() ? std::numeric_limits<double>::quiet_NaN()
+                                   : *std::min_element(ms.begin(), ms.end());
   std::printf(
       "scene=%s method=%s settings=%s normals=%s rmse=%.5f mean_error=%+.5f "
-      "time_ms=%.2f repeat=%d threads=%d pixels=%zu\n",
+      "time_ms=%.2f min_ms=%.2f repeat=%d threads=%d pixels=%zu\n",
       s.name.c_str(), m.name.c_str(), m.settings.c_str(), s.world_normal.empty() ? "depth" : "pass",
-      sc.rmse, sc.mean_error, ms, o.repeat, m.threads, s.scored);
+      sc.rmse, sc.mean_error, median(ms), min_ms, o.repeat, m.threads, sc.pixels);
   std::fflush(stdout);
   return sc;
 }
@@ -611,23 +742,32 @@ void check_output(const Options& o) {
 }
 
 int run(const Options& o) {
+  // Every method in the order reported: --method, each --run, then --compare-to.
+  std::vector<RunSpec> specs = {{o.method, o.settings, o.method_flag}};
+  specs.insert(specs.end(), o.more_runs.begin(), o.more_runs.end());
+  if (!o.compare_to.empty()) specs.push_back({o.compare_to, o.compare_settings, "--compare-set"});
   // Command-line mistakes first, before reading anything.
-  make_method(o.method, o.settings, "--set", nullptr, o.radius);
-  if (!o.compare_to.empty()) {
-    make_method(o.compare_to, o.compare_settings, "--compare-set", nullptr, o.radius);
+  for (const RunSpec& spec : specs) {
+    make_method(spec.method, spec.settings, spec.flag, nullptr, o.radius);
   }
 
   if (!o.write_ao.empty()) check_output(o);
   const Scene scene = load_scene(o);
-  int status = 0;
-  Score primary;
-  {
-    const Method m = make_method(o.method, o.settings, "--set", &scene, o.radius);
-    primary = evaluate(scene, o, m);
-    if (!o.write_ao.empty()) {
-      ssao_io::write_exr(o.write_ao, scene.width, scene.height, {"AO"}, *m.ao);
-    }
+  std::vector<Method> methods;
+  for (const RunSpec& spec : specs) {
+    methods.push_back(make_method(spec.method, spec.settings, spec.flag, &scene, o.radius));
   }
+  const std::vector<std::vector<double>> times = time_interleaved(methods, o.repeat);
+  std::vector<Score> scores;
+  for (size_t i = 0; i < methods.size(); ++i) {
+    scores.push_back(report(scene, o, methods[i], times[i]));
+  }
+  if (!o.write_ao.empty()) {
+    ssao_io::write_exr(o.write_ao, scene.width, scene.height, {"AO"}, *methods.front().ao);
+  }
+
+  int status = 0;
+  const Score& primary = scores.front();
   if (o.has_max_rmse) {
     const bool pass = primary.rmse <= o.max_rmse;  // false for NaN
     std::printf("check max-rmse: %s rmse %.5f %s %.5f: %s\n", o.method.c_str(), primary.rmse,
@@ -635,9 +775,7 @@ int run(const Options& o) {
     if (!pass) status = 1;
   }
   if (!o.compare_to.empty()) {
-    const Method m2 =
-        make_method(o.compare_to, o.compare_settings, "--compare-set", &scene, o.radius);
-    const Score other = evaluate(scene, o, m2);
+    const Score& other = scores.back();
     const double bound = other.rmse * (1.0 - o.margin);
     const bool pass = primary.rmse < bound;
     const double lower = other.rmse > 0.0 ? 100.0 * (1.0 - primary.rmse / other.rmse) : 0.0;

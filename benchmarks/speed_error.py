@@ -1,0 +1,621 @@
+#!/usr/bin/python3
+# SPDX-License-Identifier: MIT
+"""Run time against error: libssao's variants, the seed tutorial's code and Cycles' own AO pass,
+scored against Cycles' ray-traced AO pass on reference scenes made by the project's Blender
+scripts. Run through scripts/benchmark.sh; see docs/performance.md.
+
+Stages (each prints a line as it goes):
+1. the kit: every scene of scripts/blender/benchmark_scenes.py rendered by Blender with Depth,
+   Normal, beauty and the AO pass at many samples (the ground truth), cached by content under
+   build/benchmark_kit (the key hashes the two Blender scripts, Blender's version and the
+   render arguments), plus a second render of part of one scene with another seed that
+   measures the ground truth's own noise;
+2. Cycles' AO pass at 1..64 samples, set up the fastest way, each render call timed
+   (scripts/blender/cycles_ao_sweep.py), also for the heavy scene at each triangle count;
+3. libssao at several settings of every variant, the seed tutorial ports and the ray march,
+   in-process through the C API (build/bin/ssao_eval), interleaved rounds, median of --repeat;
+   every image, Cycles' included, scored by ssao_eval over the geometry pixels;
+4. OUT/speed_error.csv, OUT/complexity.csv, OUT/speed_error.png, OUT/complexity.png,
+   OUT/performance.md, and per scene the equal-error speed-up over Cycles on stdout.
+"""
+import argparse
+import hashlib
+import json
+import math
+import os
+import platform
+import shutil
+import statistics
+import subprocess
+import sys
+import time
+
+REPO_ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+BLENDER_SCRIPTS = os.path.join(REPO_ROOT, "scripts", "blender")
+KIT_SCRIPTS = [os.path.join(BLENDER_SCRIPTS, name)
+               for name in ("benchmark_scenes.py", "make_reference_scene.py")]
+SWEEP_SCRIPT = os.path.join(BLENDER_SCRIPTS, "cycles_ao_sweep.py")
+CSV_COLUMNS = ["scene", "method", "setting", "threads", "time_s", "rmse", "bias"]
+
+SD, HD = (640, 360), (1920, 1080)
+CYCLES_SAMPLES = [1, 2, 4, 8, 16, 64]
+# The region of the second, noise-measuring reference render (fractions of the frame).
+NOISE_BORDER = (0.25, 0.75, 0.25, 0.75)
+
+# Library rows: (method, setting label, ssao_eval settings). "default" is the product's default.
+LIBRARY_FULL = [
+    ("hemisphere", "default", []),
+    ("hemisphere", "samples=4", ["samples=4"]),
+    ("hemisphere", "samples=8", ["samples=8"]),
+    ("hemisphere", "samples=8,steps=3", ["samples=8", "steps=3"]),
+    ("hemisphere", "samples=32", ["samples=32"]),
+    ("sphere", "samples=8", ["variant=sphere", "samples=8"]),
+    ("sphere", "samples=16", ["variant=sphere"]),
+    ("sphere", "samples=32", ["variant=sphere", "samples=32"]),
+    ("sphere", "samples=64", ["variant=sphere", "samples=64"]),
+    ("sphere", "classic,samples=16", ["variant=sphere", "sphere_mode=classic"]),
+]
+LIBRARY_QUICK = [
+    ("hemisphere", "default", []),
+    ("hemisphere", "samples=8", ["samples=8"]),
+    ("sphere", "samples=16", ["variant=sphere"]),
+]
+# The straight ports of the seed tutorials (tests/reference/seed_ports.cpp) and the brute-force
+# ray march (the accuracy floor of any depth-buffer method; only at 640x360, it is slow).
+SEED_ROWS = [("seed-hemisphere", "samples=16", "seed-hemisphere"),
+             ("seed-sphere", "samples=16", "seed-sphere")]
+RAYMARCH_ROW = ("raymarch", "rays=128,steps=24", "raymarch")
+
+
+class Plan:
+    """What a run measures: the full benchmark or --quick."""
+
+    def __init__(self, quick, size):
+        self.quick = quick
+        if quick:
+            self.scenes = [("contact", SD), ("thin", SD), ("heavy", SD)]
+            self.reference_samples = {SD: 256}
+            self.heavy_levels = [0, 1, 2]
+            self.repeat = 1
+            self.library = LIBRARY_QUICK
+            self.seed_rows = SEED_ROWS[:1]
+            self.raymarch = False
+        else:
+            sd_scenes = ["contact", "thin", "cavity", "depth_range", "ortho", "heavy"]
+            hd_scenes = ["contact", "thin", "cavity", "depth_range", "ortho"]
+            self.scenes = [(s, SD) for s in sd_scenes] + [(s, HD) for s in hd_scenes]
+            # 1024 spp at 1920x1080 would take 10 min per scene on 2 cores: 256 spp there.
+            self.reference_samples = {SD: 1024, HD: 256}
+            self.heavy_levels = [0, 1, 2, 3, 4, 5]
+            self.repeat = 3
+            self.library = LIBRARY_FULL
+            self.seed_rows = SEED_ROWS
+            self.raymarch = True
+        if size is not None:  # one size for every scene (the smoke test's tiny frames)
+            samples = min(self.reference_samples.values())
+            self.scenes = [(s, size) for s in dict.fromkeys(name for name, _ in self.scenes)]
+            self.reference_samples = {size: samples}
+        self.noise_scene = "contact"
+
+
+def label(scene, size, level=0):
+    name = scene if level == 0 else "%s-L%d" % (scene, level)
+    return "%s@%dx%d" % (name, size[0], size[1])
+
+
+def log(message):
+    print("[%s] %s" % (time.strftime("%H:%M:%S"), message), flush=True)
+
+
+def fail(message, status=1):
+    print("benchmark: error: " + message, file=sys.stderr, flush=True)
+    sys.exit(status)
+
+
+def run_logged(command, log_path, what):
+    """Runs `command`, its output to `log_path`; exits with the log's tail if it fails."""
+    with open(log_path, "w", encoding="utf-8") as out:
+        proc = subprocess.run(command, stdout=out, stderr=subprocess.STDOUT, check=False)
+    if proc.returncode != 0:
+        with open(log_path, encoding="utf-8", errors="replace") as f:
+            tail = f.readlines()[-25:]
+        fail("%s failed (exit %d); the end of %s:\n%s"
+             % (what, proc.returncode, log_path, "".join(tail)))
+
+
+def blender_command(blender, script, arguments):
+    return [blender, "-b", "--factory-startup", "-noaudio", "--python-exit-code", "1",
+            "-P", script, "--"] + arguments
+
+
+# ---------------------------------------------------------------------------------------------
+# 1. The kit
+
+def kit_key(blender_version, arguments):
+    digest = hashlib.sha256()
+    for path in KIT_SCRIPTS:
+        with open(path, "rb") as f:
+            digest.update(f.read())
+    digest.update(blender_version.encode())
+    digest.update(" ".join(arguments).encode())
+    return digest.hexdigest()[:12]
+
+
+def kit_render(args, blender_version, scene, size, samples, seed=1, border=None):
+    """The prefix of a cached reference render, rendering it first if it is not there."""
+    arguments = ["--scene", scene, "--width", str(size[0]), "--height", str(size[1]),
+                 "--samples", str(samples), "--seed", str(seed), "--threads", str(args.threads)]
+    if border:
+        arguments += ["--border", ",".join(str(v) for v in border)]
+    name = "%s-%ds%d%s-%s" % (label(scene, size), samples, seed, "-part" if border else "",
+                              kit_key(blender_version, arguments))
+    folder = os.path.join(args.kit, name)
+    prefix = os.path.join(folder, "ref")
+    if os.path.isfile(prefix + ".json"):
+        return prefix
+    log("kit: rendering %s at %d spp%s (cached in %s)"
+        % (label(scene, size), samples, " (noise check)" if border else "", folder))
+    partial = folder + ".partial"
+    shutil.rmtree(partial, ignore_errors=True)
+    os.makedirs(partial)
+    start = time.perf_counter()
+    run_logged(blender_command(args.blender, KIT_SCRIPTS[0],
+                               arguments + ["--out", os.path.join(partial, "ref")]),
+               os.path.join(partial, "blender.log"), "rendering " + label(scene, size))
+    shutil.rmtree(folder, ignore_errors=True)
+    os.replace(partial, folder)  # complete renders only, under the final name
+    log("kit: %s done in %.0f s" % (label(scene, size), time.perf_counter() - start))
+    return prefix
+
+
+# ---------------------------------------------------------------------------------------------
+# 2. Cycles' AO pass at fewer samples
+
+def cycles_sweep(args, plan, scene, size, level):
+    folder = os.path.join(args.out, "cycles", label(scene, size, level))
+    shutil.rmtree(folder, ignore_errors=True)
+    os.makedirs(folder)
+    prefix = os.path.join(folder, "sweep")
+    log("cycles: %s at %s spp, %d run(s) each" % (label(scene, size, level),
+                                                   ",".join(map(str, CYCLES_SAMPLES)),
+                                                   plan.repeat))
+    run_logged(blender_command(args.blender, SWEEP_SCRIPT,
+                               ["--scene", scene, "--level", str(level), "--width", str(size[0]),
+                                "--height", str(size[1]),
+                                "--samples", ",".join(map(str, CYCLES_SAMPLES)),
+                                "--repeat", str(plan.repeat), "--threads", str(args.threads),
+                                "--out", prefix]),
+               os.path.join(folder, "blender.log"), "Cycles sweep of " + label(scene, size, level))
+    with open(prefix + ".json", encoding="utf-8") as f:
+        sweep = json.load(f)
+    for run in sweep["runs"]:
+        run["file"] = os.path.join(folder, run["file"])
+    return sweep
+
+
+# ---------------------------------------------------------------------------------------------
+# 3. Scoring (and timing the library) with ssao_eval
+
+def run_eval(args, reference, runs, repeat, what):
+    """ssao_eval on the reference render with one --run per entry of `runs` (method and its
+    settings); returns one dict of the result line's fields per run, in order."""
+    with open(reference + ".json", encoding="utf-8") as f:
+        radius = json.load(f)["ao_distance"]
+    command = [args.eval, reference + ".exr", "--camera", reference + ".camera.json",
+               "--radius", repr(radius), "--repeat", str(repeat)]
+    for method, settings in runs:
+        command += ["--run", " ".join([method] + settings)]
+    proc = subprocess.run(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                          check=False)
+    results = [dict(field.split("=", 1) for field in line.split(" "))
+               for line in proc.stdout.splitlines() if line.startswith("scene=")]
+    if proc.returncode != 0 or len(results) != len(runs):
+        fail("ssao_eval failed on %s (exit %d): %s\n%s%s" % (what, proc.returncode,
+                                                             " ".join(command), proc.stdout,
+                                                             proc.stderr))
+    return results
+
+
+def measure_scene(args, plan, reference, scene, size, sweeps):
+    """CSV rows for one scene and size: the library, the seed ports, the ray march, Cycles."""
+    rows, runs = [], []
+    threads = "threads=%d" % args.threads
+    for method, setting, settings in plan.library:
+        rows.append([method, setting])
+        runs.append(("ssao", settings + [threads]))
+    for method, setting, eval_method in plan.seed_rows:
+        rows.append([method, setting])
+        runs.append((eval_method, []))
+    if plan.raymarch and size == SD:
+        rows.append(list(RAYMARCH_ROW[:2]))
+        runs.append((RAYMARCH_ROW[2], []))
+    timed = len(runs)
+    for level, sweep in sweeps:
+        for run in sweep["runs"]:
+            rows.append(["cycles", "samples=%d" % run["samples"], run["median_s"],
+                         sweep["threads"], label(scene, size, level)])
+            runs.append(("image", ["path=" + run["file"]]))
+    log("library: %s, %d configurations x %d run(s), and %d Cycles images"
+        % (label(scene, size), timed, plan.repeat, len(runs) - timed))
+    results = run_eval(args, reference, runs, plan.repeat, label(scene, size))
+    out = []
+    for row, result in zip(rows, results):
+        if row[0] == "cycles":
+            method, setting, seconds, threads_used, scene_label = row
+        else:
+            (method, setting), scene_label = row, label(scene, size)
+            seconds, threads_used = float(result["time_ms"]) / 1000.0, int(result["threads"])
+        out.append({"scene": scene_label, "method": method, "setting": setting,
+                    "threads": threads_used, "time_s": seconds, "rmse": float(result["rmse"]),
+                    "bias": float(result["mean_error"])})
+    return out
+
+
+def reference_noise(args, reference, part):
+    """RMS per-pixel noise of one reference render: the difference of two renders with other
+    seeds over the region both hold, divided by sqrt(2)."""
+    with open(part + ".json", encoding="utf-8") as f:
+        border = json.load(f)["border"]
+    result = run_eval(args, reference, [("image", ["path=" + part + ".exr",
+                                                   "region=" + ",".join(map(str, border))])],
+                      1, "the noise check")[0]
+    return float(result["rmse"]) / math.sqrt(2.0), int(result["pixels"])
+
+
+# ---------------------------------------------------------------------------------------------
+# 4. Results
+
+def pareto_front(points):
+    """The points (time, rmse) that no other point beats in both, by increasing time."""
+    front, best = [], math.inf
+    for t, e in sorted(points):
+        if e < best:
+            front.append((t, e))
+            best = e
+    return front
+
+
+def cycles_time_to(rmse, cycles_rows):
+    """Time Cycles needs to reach `rmse`, interpolated (log time against log RMSE) along its
+    Pareto front; returns (seconds, relation) with relation '<=' or '>=' when `rmse` lies
+    outside the measured range."""
+    front = pareto_front([(r["time_s"], r["rmse"]) for r in cycles_rows])
+    if rmse >= front[0][1]:
+        return front[0][0], "<="
+    if rmse <= front[-1][1]:
+        return front[-1][0], ">="
+    for (t0, e0), (t1, e1) in zip(front, front[1:]):
+        if e1 <= rmse <= e0:
+            f = (math.log(rmse) - math.log(e0)) / (math.log(e1) - math.log(e0))
+            return math.exp(math.log(t0) + f * (math.log(t1) - math.log(t0))), "="
+    raise AssertionError("unreachable")
+
+
+def speedups(rows):
+    """Per scene: our default's time and RMSE, Cycles' time to that RMSE, the ratio."""
+    out = []
+    for scene in dict.fromkeys(r["scene"] for r in rows):
+        ours = [r for r in rows if r["scene"] == scene and r["setting"] == "default"]
+        cycles = [r for r in rows if r["scene"] == scene and r["method"] == "cycles"]
+        if not ours or not cycles:
+            continue
+        t_cycles, relation = cycles_time_to(ours[0]["rmse"], cycles)
+        out.append({"scene": scene, "time_s": ours[0]["time_s"], "rmse": ours[0]["rmse"],
+                    "cycles_s": t_cycles, "relation": relation,
+                    "speedup": t_cycles / ours[0]["time_s"]})
+    return out
+
+
+def write_csv(path, columns, rows):
+    with open(path + ".tmp", "w", encoding="utf-8") as f:
+        f.write(",".join(columns) + "\n")
+        for r in rows:
+            f.write(",".join(format_value(r[c]) for c in columns) + "\n")
+    os.replace(path + ".tmp", path)
+
+
+def format_value(value):
+    if isinstance(value, float):
+        return "%.6g" % value
+    return str(value)
+
+
+def plot_speed_error(path, rows, truth):
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    scenes = [s for s in dict.fromkeys(r["scene"] for r in rows) if "-L" not in s]
+    columns = min(3, len(scenes))
+    lines = (len(scenes) + columns - 1) // columns
+    fig, axes = plt.subplots(lines, columns, figsize=(5.2 * columns, 4.0 * lines), squeeze=False)
+    styles = {"hemisphere": ("C0", "o"), "sphere": ("C1", "s"), "cycles": ("C3", "^"),
+              "seed-hemisphere": ("C2", "D"), "seed-sphere": ("C4", "v"),
+              "raymarch": ("C5", "P")}
+    for ax, scene in zip(axes.flat, scenes):
+        mine = [r for r in rows if r["scene"] == scene]
+        for method, (colour, marker) in styles.items():
+            points = sorted((r["time_s"], r["rmse"]) for r in mine if r["method"] == method)
+            if points:
+                ax.plot([p[0] for p in points], [p[1] for p in points], marker=marker,
+                        color=colour, linestyle="-" if len(points) > 1 else "none",
+                        label=method, markersize=5)
+        for r in mine:
+            if r["setting"] == "default":
+                ax.plot([r["time_s"]], [r["rmse"]], marker="*", color="k", markersize=13,
+                        linestyle="none", label="default")
+        front = pareto_front([(r["time_s"], r["rmse"]) for r in mine])
+        ax.step([p[0] for p in front], [p[1] for p in front], where="post", color="0.5",
+                linewidth=3, alpha=0.35, label="Pareto front")
+        ax.set_xscale("log")
+        ax.set_title(scene)
+        ax.set_xlabel("run time (s, log)")
+        ax.set_ylabel("RMSE against %s" % truth)
+        ax.grid(True, which="both", alpha=0.3)
+    for ax in list(axes.flat)[len(scenes):]:
+        ax.axis("off")
+    axes.flat[0].legend(fontsize=7)
+    fig.tight_layout()
+    fig.savefig(path, dpi=90)
+    plt.close(fig)
+
+
+def plot_complexity(path, complexity):
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    fig, ax = plt.subplots(figsize=(6.5, 4.2))
+    for samples, colour in zip(sorted({r["samples"] for r in complexity if r["samples"]}),
+                               ["C%d" % i for i in range(3, 10)]):
+        points = sorted((r["triangles"], r["time_s"]) for r in complexity
+                        if r["samples"] == samples)
+        ax.plot([p[0] for p in points], [p[1] for p in points], marker="^", color=colour,
+                label="Cycles AO pass, %d spp" % samples)
+    ours = sorted((r["triangles"], r["time_s"]) for r in complexity if not r["samples"])
+    ax.plot([p[0] for p in ours], [p[1] for p in ours], marker="*", color="k", markersize=10,
+            label="libssao default")
+    ax.set_xscale("log")
+    ax.set_yscale("log")
+    ax.set_xlabel("triangles in the scene")
+    ax.set_ylabel("run time (s)")
+    ax.set_title("heavy scene, %s" % complexity[0]["size"])
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(path, dpi=90)
+    plt.close(fig)
+
+
+def machine_description(args, blender_version):
+    cpu = platform.processor() or platform.machine()
+    try:
+        with open("/proc/cpuinfo", encoding="utf-8") as f:
+            for line in f:
+                if line.startswith("model name"):
+                    cpu = line.split(":", 1)[1].strip()
+                    break
+    except OSError:
+        pass
+    commit = subprocess.run(["git", "-C", REPO_ROOT, "describe", "--always", "--dirty"],
+                            stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True,
+                            check=False).stdout.strip()
+    return ("%s, %d cores seen (%d threads used), %s; %s; commit %s; %s"
+            % (cpu, os.cpu_count() or 0, args.threads, platform.platform(), blender_version,
+               commit or "unknown", time.strftime("%Y-%m-%d")))
+
+
+def markdown_table(header, lines):
+    out = ["| " + " | ".join(header) + " |", "|" + "|".join("---" for _ in header) + "|"]
+    out += ["| " + " | ".join(str(c) for c in line) + " |" for line in lines]
+    return "\n".join(out)
+
+
+def speedup_lines(table):
+    return [[s["scene"], "%.1f ms" % (1000 * s["time_s"]), "%.4f" % s["rmse"],
+             "%s %.2f s" % ("" if s["relation"] == "=" else s["relation"], s["cycles_s"]),
+             "%s%.1fx" % ("" if s["relation"] == "=" else s["relation"], s["speedup"])]
+            for s in table]
+
+
+def write_markdown(path, args, plan, rows, table, complexity, noise, machine, command):
+    default_rows = [r for r in rows if r["setting"] == "default"]
+    lines = [
+        "# Performance: run time against error",
+        "",
+        "Generated by `%s` on %s." % (command, machine),
+        "Every figure below comes from that one run; rerun the command to regenerate the page "
+        "(the kit of reference renders is cached by content in `build/benchmark_kit`).",
+        "",
+        "RMSE and bias (mean of method - truth; positive = too little occlusion) are over the "
+        "pixels that show geometry (depth finite and below 0.9 x clip_end), against Cycles' AO "
+        "pass at %s. Its own per-pixel noise, measured as the difference of a second render "
+        "with another seed over %d pixels of `%s`: %s. "
+        % (", ".join("%d spp at %dx%d" % (n, w, h)
+                     for (w, h), n in sorted(plan.reference_samples.items())),
+           noise[0][2] if noise else 0, plan.noise_scene,
+           ", ".join("%.4f at %s" % (n, size) for n, size, _ in noise)),
+        "Times are medians of %d interleaved run(s) of the AO computation alone (libssao "
+        "through the C API, %d threads; the seed ports on one thread) and of the Cycles "
+        "render call (scene sync, BVH build and sampling; %d threads). A Cycles row with "
+        "`samples=N` is its AO pass rendered the fastest correct way at N samples per pixel."
+        % (plan.repeat, args.threads, args.threads),
+        "",
+        "## Equal-error speed-up over Cycles' AO pass",
+        "",
+        "The time Cycles needs to reach our default's RMSE (interpolated, log time against "
+        "log RMSE, along its Pareto front) over our default's time. `<=` means Cycles at 1 "
+        "sample per pixel is already as accurate, so its 1-spp time is an upper bound.",
+        "",
+        markdown_table(["scene", "libssao default", "RMSE", "Cycles to the same RMSE",
+                        "speed-up"], speedup_lines(table)),
+        "",
+        "![run time against RMSE](images/speed_error.png)",
+        "",
+        "## Scene complexity",
+        "",
+        "The heavy scene with every face split in four 0 to %d times: the same shape, so the "
+        "same depth and normal passes and the same AO. Cycles' cost grows with the triangles; "
+        "libssao reads only the passes, so its time is the one measured on the scene."
+        % max(plan.heavy_levels),
+        "",
+        markdown_table(["triangles"] + ["Cycles %d spp" % n for n in CYCLES_SAMPLES]
+                       + ["libssao default"],
+                       complexity_lines(complexity)),
+        "",
+        "![time against triangle count](images/complexity.png)",
+        "",
+        "## Every row",
+        "",
+        "The same figures as `speed_error.csv` (columns %s)." % ", ".join(CSV_COLUMNS),
+        "",
+        markdown_table(["scene", "method", "setting", "threads", "time (ms)", "RMSE", "bias"],
+                       [[r["scene"], r["method"],
+                         "**default**" if r["setting"] == "default" else r["setting"],
+                         r["threads"], "%.1f" % (1000 * r["time_s"]), "%.4f" % r["rmse"],
+                         "%+.4f" % r["bias"]] for r in rows]),
+        "",
+        "Mean RMSE of the default over the %d scene(s): %.4f."
+        % (len(default_rows), statistics.mean(r["rmse"] for r in default_rows)),
+        "",
+    ]
+    with open(path + ".tmp", "w", encoding="utf-8") as f:
+        f.write("\n".join(lines))
+    os.replace(path + ".tmp", path)
+
+
+def complexity_lines(complexity):
+    lines = []
+    for triangles in sorted({r["triangles"] for r in complexity}):
+        mine = {r["samples"]: r["time_s"] for r in complexity if r["triangles"] == triangles}
+        lines.append(["{:,}".format(triangles)]
+                     + ["%.2f s" % mine[n] if n in mine else "" for n in CYCLES_SAMPLES]
+                     + ["%.1f ms" % (1000 * mine[0])])
+    return lines
+
+
+# ---------------------------------------------------------------------------------------------
+
+def parse_args():
+    parser = argparse.ArgumentParser(
+        prog="benchmark.sh",
+        description="Run time against error of libssao, the seed tutorial code and Cycles' AO "
+                    "pass on reference scenes rendered by Blender (see docs/performance.md).")
+    parser.add_argument("--quick", action="store_true",
+                        help="3 scenes at 640x360, fewer settings, one run each (about 5 min)")
+    parser.add_argument("--out", default=os.path.join(REPO_ROOT, "build", "benchmark"),
+                        help="output folder (default build/benchmark)")
+    parser.add_argument("--size", default=None, metavar="WxH",
+                        help="render every scene at this one size instead (for smoke tests)")
+    parser.add_argument("--kit", default=os.path.join(REPO_ROOT, "build", "benchmark_kit"),
+                        help="cache of the reference renders (default build/benchmark_kit)")
+    parser.add_argument("--threads", type=int, default=os.cpu_count() or 1,
+                        help="threads for libssao and Cycles (default: every core)")
+    parser.add_argument("--kit-only", action="store_true",
+                        help="only render (or find) the reference scenes")
+    parser.add_argument("--update-docs", action="store_true",
+                        help="also copy performance.md and the plots into docs/")
+    parser.add_argument("--blender", default=shutil.which("blender") or "blender")
+    parser.add_argument("--eval", default=os.path.join(REPO_ROOT, "build", "bin", "ssao_eval"))
+    args = parser.parse_args()
+    if args.size is not None:
+        try:
+            w, h = (int(v) for v in args.size.lower().split("x"))
+        except ValueError:
+            parser.error("--size: expected WxH, e.g. 96x54")
+        if not (8 <= w <= 8192 and 8 <= h <= 8192):
+            parser.error("--size: width and height must be in 8..8192")
+        args.size = (w, h)
+    if args.threads < 1:
+        parser.error("--threads must be positive")
+    if not os.path.isfile(args.eval):
+        fail("no %s: build the project first (scripts/setup.sh or scripts/build.sh)" % args.eval)
+    if shutil.which(args.blender) is None:
+        fail("Blender not found ('%s'): install it (scripts/install_deps.sh) or pass --blender"
+             % args.blender)
+    try:
+        import matplotlib  # noqa: F401
+    except ImportError:
+        fail("matplotlib missing: install python3-matplotlib (scripts/install_deps.sh)")
+    args.out = os.path.abspath(args.out)
+    args.kit = os.path.abspath(args.kit)
+    return args
+
+
+def main():
+    args = parse_args()
+    plan = Plan(args.quick, args.size)
+    start = time.perf_counter()
+    blender_version = subprocess.run([args.blender, "--version"], stdout=subprocess.PIPE,
+                                     stderr=subprocess.DEVNULL, text=True,
+                                     check=False).stdout.splitlines()[0].strip()
+    os.makedirs(args.kit, exist_ok=True)
+    references = {(scene, size): kit_render(args, blender_version, scene, size,
+                                            plan.reference_samples[size])
+                  for scene, size in plan.scenes}
+    noise_parts = {size: kit_render(args, blender_version, plan.noise_scene, size,
+                                    plan.reference_samples[size], seed=2, border=NOISE_BORDER)
+                   for size in plan.reference_samples}
+    if args.kit_only:
+        log("kit ready in %s (%.0f s)" % (args.kit, time.perf_counter() - start))
+        return 0
+
+    os.makedirs(args.out, exist_ok=True)
+    noise = []
+    for size, part in sorted(noise_parts.items()):
+        sigma, pixels = reference_noise(args, references[(plan.noise_scene, size)], part)
+        noise.append((sigma, "%dx%d" % size, pixels))
+    rows, complexity = [], []
+    for scene, size in plan.scenes:
+        levels = plan.heavy_levels if scene == "heavy" else [0]
+        sweeps = [(level, cycles_sweep(args, plan, scene, size, level)) for level in levels]
+        scene_rows = measure_scene(args, plan, references[(scene, size)], scene, size, sweeps)
+        rows += scene_rows
+        if scene == "heavy":
+            ours = next(r for r in scene_rows if r["setting"] == "default")
+            for level, sweep in sweeps:
+                for run in sweep["runs"]:
+                    complexity.append({"size": "%dx%d" % size, "level": level,
+                                       "triangles": sweep["triangles"], "method": "cycles",
+                                       "samples": run["samples"], "time_s": run["median_s"]})
+                complexity.append({"size": "%dx%d" % size, "level": level,
+                                   "triangles": sweep["triangles"], "method": "libssao",
+                                   "samples": 0, "time_s": ours["time_s"]})
+
+    write_csv(os.path.join(args.out, "speed_error.csv"), CSV_COLUMNS, rows)
+    write_csv(os.path.join(args.out, "complexity.csv"),
+              ["size", "level", "triangles", "method", "samples", "time_s"], complexity)
+    plot_speed_error(os.path.join(args.out, "speed_error.png"), rows,
+                     "Cycles' AO pass at " + ", ".join("%d spp (%dx%d)" % (n, w, h) for (w, h), n
+                                                       in sorted(plan.reference_samples.items())))
+    if complexity:
+        plot_complexity(os.path.join(args.out, "complexity.png"), complexity)
+    table = speedups(rows)
+    machine = machine_description(args, blender_version)
+    command = "scripts/benchmark.sh" + (" --quick" if args.quick else "") + (
+        " --size %dx%d" % args.size if args.size else "")
+    write_markdown(os.path.join(args.out, "performance.md"), args, plan, rows, table,
+                   complexity, noise, machine, command)
+    if args.update_docs:
+        images = os.path.join(REPO_ROOT, "docs", "images")
+        shutil.copy(os.path.join(args.out, "speed_error.png"), images)
+        if complexity:
+            shutil.copy(os.path.join(args.out, "complexity.png"), images)
+        shutil.copy(os.path.join(args.out, "performance.md"),
+                    os.path.join(REPO_ROOT, "docs", "performance.md"))
+
+    print()
+    print("Equal-error speed-up over Cycles' AO pass (%s):" % machine)
+    print(markdown_table(["scene", "libssao default", "RMSE", "Cycles to the same RMSE",
+                          "speed-up"], speedup_lines(table)))
+    if complexity:
+        print()
+        print("Scene complexity (heavy scene, %s):" % complexity[0]["size"])
+        print(markdown_table(["triangles"] + ["Cycles %d spp" % n for n in CYCLES_SAMPLES]
+                             + ["libssao default"], complexity_lines(complexity)))
+    print()
+    log("wrote %s/{speed_error.csv,speed_error.png,complexity.csv,complexity.png,"
+        "performance.md} in %.0f s" % (args.out, time.perf_counter() - start))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,184 @@
+#!/usr/bin/python3
+# SPDX-License-Identifier: MIT
+"""Smoke test of scripts/benchmark.sh: runs `--quick` at a tiny size with the real Blender and
+ssao_eval, then checks the files it writes, their columns and what the measurements must show
+whatever the machine (no timing is asserted). Also checks the speed-up interpolation on
+made-up curves.
+
+    /usr/bin/python3 tests/benchmark/test_benchmark.py --build-dir build --scratch DIR [-v]
+"""
+import argparse
+import csv
+import math
+import os
+import subprocess
+import sys
+import unittest
+
+REPO_ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+sys.path.insert(0, os.path.join(REPO_ROOT, "benchmarks"))
+import speed_error  # noqa: E402
+
+SIZE = "64x36"
+SCENES = ["contact@%s" % SIZE, "thin@%s" % SIZE, "heavy@%s" % SIZE]
+OPTIONS = {}
+
+
+def run_benchmark(*extra):
+    env = dict(os.environ, SSAO_BUILD_DIR=OPTIONS["build_dir"])
+    return subprocess.run([os.path.join(REPO_ROOT, "scripts", "benchmark.sh")] + list(extra),
+                          stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env,
+                          check=False)
+
+
+class QuickRunTest(unittest.TestCase):
+    """One `--quick --size 64x36` run, checked from every side."""
+
+    @classmethod
+    def setUpClass(cls):
+        cls.out = os.path.join(OPTIONS["scratch"], "out")
+        cls.kit = os.path.join(OPTIONS["scratch"], "kit")
+        cls.proc = run_benchmark("--quick", "--size", SIZE, "--out", cls.out, "--kit", cls.kit)
+        if cls.proc.returncode != 0:
+            raise AssertionError("benchmark.sh failed (exit %d):\n%s\n%s"
+                                 % (cls.proc.returncode, cls.proc.stdout, cls.proc.stderr))
+        with open(os.path.join(cls.out, "speed_error.csv"), encoding="utf-8") as f:
+            cls.header = f.readline().strip()
+            f.seek(0)
+            cls.rows = list(csv.DictReader(f))
+        with open(os.path.join(cls.out, "complexity.csv"), encoding="utf-8") as f:
+            cls.complexity = list(csv.DictReader(f))
+
+    def rows_of(self, scene, method):
+        return [r for r in self.rows if r["scene"] == scene and r["method"] == method]
+
+    def test_files_exist(self):
+        for name in ("speed_error.csv", "speed_error.png", "complexity.csv", "complexity.png",
+                     "performance.md"):
+            path = os.path.join(self.out, name)
+            self.assertTrue(os.path.isfile(path), path)
+            self.assertGreater(os.path.getsize(path), 100, path)
+        for name in ("speed_error.png", "complexity.png"):
+            with open(os.path.join(self.out, name), "rb") as f:
+                self.assertEqual(f.read(8), b"\x89PNG\r\n\x1a\n", name)
+
+    def test_csv_columns_and_values(self):
+        self.assertEqual(self.header, "scene,method,setting,threads,time_s,rmse,bias")
+        self.assertGreater(len(self.rows), 20)
+        for r in self.rows:
+            self.assertNotIn(None, r.values(), r)
+            self.assertGreaterEqual(int(r["threads"]), 1, r)
+            self.assertGreater(float(r["time_s"]), 0.0, r)
+            self.assertTrue(0.0 <= float(r["rmse"]) <= 1.0, r)
+            self.assertTrue(-1.0 <= float(r["bias"]) <= 1.0, r)
+            self.assertLessEqual(abs(float(r["bias"])), float(r["rmse"]) + 1e-6, r)
+
+    def test_every_scene_has_every_method(self):
+        scenes = {r["scene"] for r in self.rows}
+        for scene in SCENES:
+            self.assertIn(scene, scenes)
+            defaults = [r for r in self.rows_of(scene, "hemisphere") if r["setting"] == "default"]
+            self.assertEqual(len(defaults), 1, scene)
+            self.assertTrue(self.rows_of(scene, "sphere"), scene)
+            self.assertTrue(self.rows_of(scene, "seed-hemisphere"), scene)
+            cycles = sorted(int(r["setting"].split("=")[1]) for r in self.rows_of(scene, "cycles"))
+            self.assertEqual(cycles, speed_error.CYCLES_SAMPLES, scene)
+        for level in (1, 2):
+            self.assertTrue(self.rows_of("heavy-L%d@%s" % (level, SIZE), "cycles"))
+
+    def test_cycles_fast_setup_writes_a_correct_ao_pass(self):
+        # Rendered the fast way (no bounces, no lights, material override, AO pass only), the AO
+        # pass must converge to the ground truth: unbiased, and 64 spp far closer than 1 spp.
+        for scene in SCENES + ["heavy-L2@%s" % SIZE]:
+            by_samples = {int(r["setting"].split("=")[1]): r for r in self.rows_of(scene, "cycles")}
+            self.assertLess(float(by_samples[64]["rmse"]), 0.5 * float(by_samples[1]["rmse"]),
+                            scene)
+            self.assertLess(abs(float(by_samples[64]["bias"])), 0.02, scene)
+
+    def test_complexity_grows_by_four_per_level(self):
+        triangles = {}
+        for r in self.complexity:
+            triangles[int(r["level"])] = int(r["triangles"])
+        self.assertEqual(sorted(triangles), [0, 1, 2])
+        self.assertTrue(8000 <= triangles[0] <= 12000, triangles)
+        for level in (1, 2):
+            self.assertTrue(3.5 <= triangles[level] / triangles[level - 1] <= 4.2, triangles)
+        methods = {r["method"] for r in self.complexity}
+        self.assertEqual(methods, {"cycles", "libssao"})
+
+    def test_report_and_summary(self):
+        with open(os.path.join(self.out, "performance.md"), encoding="utf-8") as f:
+            text = f.read()
+        self.assertIn("scripts/benchmark.sh --quick --size %s" % SIZE, text)
+        self.assertIn("images/speed_error.png", text)
+        self.assertIn("images/complexity.png", text)
+        self.assertIn("Equal-error speed-up over Cycles' AO pass", self.proc.stdout)
+        for scene in SCENES:
+            self.assertIn("| %s |" % scene, text)
+            self.assertRegex(self.proc.stdout, r"\| %s \| [0-9.]+ ms \| 0\.\d{4} \|" % scene)
+
+    def test_kit_is_cached(self):
+        proc = run_benchmark("--quick", "--size", SIZE, "--kit", self.kit, "--kit-only")
+        self.assertEqual(proc.returncode, 0, proc.stderr)
+        self.assertIn("kit ready", proc.stdout)
+        self.assertNotIn("kit: rendering", proc.stdout)
+
+
+class UsageTest(unittest.TestCase):
+    def test_bad_size(self):
+        proc = run_benchmark("--size", "3x3", "--out", os.path.join(OPTIONS["scratch"], "bad"))
+        self.assertEqual(proc.returncode, 2)
+        self.assertIn("--size", proc.stderr)
+        self.assertFalse(os.path.exists(os.path.join(OPTIONS["scratch"], "bad")))
+
+    def test_unknown_option(self):
+        proc = run_benchmark("--frobnicate")
+        self.assertEqual(proc.returncode, 2)
+        self.assertIn("unrecognized arguments", proc.stderr)
+
+
+class SpeedupTest(unittest.TestCase):
+    """The equal-error interpolation on made-up Cycles curves."""
+
+    CYCLES = [{"time_s": 1.0, "rmse": 0.4}, {"time_s": 2.0, "rmse": 0.2},
+              {"time_s": 3.0, "rmse": 0.25},  # slower and worse: off the Pareto front
+              {"time_s": 4.0, "rmse": 0.1}]
+
+    def test_on_a_measured_point(self):
+        self.assertEqual(speed_error.cycles_time_to(0.2, self.CYCLES), (2.0, "="))
+
+    def test_between_points_in_log_log(self):
+        seconds, relation = speed_error.cycles_time_to(math.sqrt(0.2 * 0.1), self.CYCLES)
+        self.assertEqual(relation, "=")
+        self.assertAlmostEqual(seconds, math.sqrt(8.0), places=9)
+
+    def test_outside_the_measured_range(self):
+        self.assertEqual(speed_error.cycles_time_to(0.5, self.CYCLES), (1.0, "<="))
+        self.assertEqual(speed_error.cycles_time_to(0.05, self.CYCLES), (4.0, ">="))
+
+    def test_pareto_front(self):
+        front = speed_error.pareto_front([(r["time_s"], r["rmse"]) for r in self.CYCLES])
+        self.assertEqual(front, [(1.0, 0.4), (2.0, 0.2), (4.0, 0.1)])
+
+    def test_speedups_per_scene(self):
+        rows = [dict(r, scene="s", method="cycles", setting="samples=1") for r in self.CYCLES]
+        rows.append({"scene": "s", "method": "hemisphere", "setting": "default",
+                     "time_s": 0.02, "rmse": 0.2})
+        (result,) = speed_error.speedups(rows)
+        self.assertAlmostEqual(result["speedup"], 100.0)
+        self.assertEqual(result["relation"], "=")
+
+
+def main():
+    parser = argparse.ArgumentParser()
+    parser.add_argument("--build-dir", required=True)
+    parser.add_argument("--scratch", required=True)
+    args, rest = parser.parse_known_args()
+    OPTIONS["build_dir"] = os.path.abspath(args.build_dir)
+    OPTIONS["scratch"] = os.path.abspath(args.scratch)
+    os.makedirs(OPTIONS["scratch"], exist_ok=True)
+    unittest.main(argv=[sys.argv[0]] + rest)
+
+
+if __name__ == "__main__":
+    main()
