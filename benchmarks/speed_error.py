@@ -70,7 +70,7 @@ RAYMARCH_ROW = ("raymarch", "rays=128,steps=24", "raymarch")
 class Plan:
     """What a run measures: the full benchmark or --quick."""
 
-    def __init__(self, quick, size):
+    def __init__(self, quick, size, hd_samples):
         self.quick = quick
         if quick:
             self.scenes = [("contact", SD), ("thin", SD), ("heavy", SD)]
@@ -84,8 +84,8 @@ class Plan:
             sd_scenes = ["contact", "thin", "cavity", "depth_range", "ortho", "heavy"]
             hd_scenes = ["contact", "thin", "cavity", "depth_range", "ortho"]
             self.scenes = [(s, SD) for s in sd_scenes] + [(s, HD) for s in hd_scenes]
-            # 1024 spp at 1920x1080 would take 10 min per scene on 2 cores: 256 spp there.
-            self.reference_samples = {SD: 1024, HD: 256}
+            # 1024 spp at 1920x1080 takes about 17 min per scene on 2 cores: 256 by default.
+            self.reference_samples = {SD: 1024, HD: hd_samples}
             self.heavy_levels = [0, 1, 2, 3, 4, 5]
             self.repeat = 3
             self.library = LIBRARY_FULL
@@ -204,6 +204,9 @@ def run_eval(args, reference, runs, repeat, what):
     command = [args.eval, reference + ".exr", "--camera", reference + ".camera.json",
                "--radius", repr(radius), "--repeat", str(repeat)]
     for method, settings in runs:
+        if any(c.isspace() for c in "".join(settings)):
+            fail("ssao_eval takes no white space in a setting: %s (move the kit or the output "
+                 "folder to a path without spaces)" % settings)
         command += ["--run", " ".join([method] + settings)]
     proc = subprocess.run(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
                           check=False)
@@ -218,37 +221,34 @@ def run_eval(args, reference, runs, repeat, what):
 
 def measure_scene(args, plan, reference, scene, size, sweeps):
     """CSV rows for one scene and size: the library, the seed ports, the ray march, Cycles."""
-    rows, runs = [], []
-    threads = "threads=%d" % args.threads
+    entries = []  # (the row's fields known before scoring, the ssao_eval run that scores it)
     for method, setting, settings in plan.library:
-        rows.append([method, setting])
-        runs.append(("ssao", settings + [threads]))
+        entries.append(({"method": method, "setting": setting},
+                        ("ssao", settings + ["threads=%d" % args.threads])))
     for method, setting, eval_method in plan.seed_rows:
-        rows.append([method, setting])
-        runs.append((eval_method, []))
+        entries.append(({"method": method, "setting": setting}, (eval_method, [])))
     if plan.raymarch and size == SD:
-        rows.append(list(RAYMARCH_ROW[:2]))
-        runs.append((RAYMARCH_ROW[2], []))
-    timed = len(runs)
+        entries.append(({"method": RAYMARCH_ROW[0], "setting": RAYMARCH_ROW[1]},
+                        (RAYMARCH_ROW[2], [])))
+    timed = len(entries)
     for level, sweep in sweeps:
         for run in sweep["runs"]:
-            rows.append(["cycles", "samples=%d" % run["samples"], run["median_s"],
-                         sweep["threads"], label(scene, size, level)])
-            runs.append(("image", ["path=" + run["file"]]))
+            entries.append(({"scene": label(scene, size, level), "method": "cycles",
+                             "setting": "samples=%d" % run["samples"],
+                             "time_s": run["median_s"], "threads": sweep["threads"]},
+                            ("image", ["path=" + run["file"]])))
     log("library: %s, %d configurations x %d run(s), and %d Cycles images"
-        % (label(scene, size), timed, plan.repeat, len(runs) - timed))
-    results = run_eval(args, reference, runs, plan.repeat, label(scene, size))
-    out = []
-    for row, result in zip(rows, results):
-        if row[0] == "cycles":
-            method, setting, seconds, threads_used, scene_label = row
-        else:
-            (method, setting), scene_label = row, label(scene, size)
-            seconds, threads_used = float(result["time_ms"]) / 1000.0, int(result["threads"])
-        out.append({"scene": scene_label, "method": method, "setting": setting,
-                    "threads": threads_used, "time_s": seconds, "rmse": float(result["rmse"]),
-                    "bias": float(result["mean_error"])})
-    return out
+        % (label(scene, size), timed, plan.repeat, len(entries) - timed))
+    results = run_eval(args, reference, [run for _, run in entries], plan.repeat,
+                       label(scene, size))
+    rows = []
+    for (known, _), result in zip(entries, results):
+        row = {"scene": label(scene, size), "time_s": float(result["time_ms"]) / 1000.0,
+               "threads": int(result["threads"])}
+        row.update(known)
+        row.update(rmse=float(result["rmse"]), bias=float(result["mean_error"]))
+        rows.append(row)
+    return rows
 
 
 def reference_noise(args, reference, part):
@@ -320,10 +320,16 @@ def format_value(value):
     return str(value)
 
 
-def plot_speed_error(path, rows, truth):
+def pyplot():
+    """matplotlib's pyplot drawing into files (no display needed)."""
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
+    return plt
+
+
+def plot_speed_error(path, rows, truth):
+    plt = pyplot()
     scenes = [s for s in dict.fromkeys(r["scene"] for r in rows) if "-L" not in s]
     columns = min(3, len(scenes))
     lines = (len(scenes) + columns - 1) // columns
@@ -360,9 +366,7 @@ def plot_speed_error(path, rows, truth):
 
 
 def plot_complexity(path, complexity):
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    plt = pyplot()
     fig, ax = plt.subplots(figsize=(6.5, 4.2))
     for samples, colour in zip(sorted({r["samples"] for r in complexity if r["samples"]}),
                                ["C%d" % i for i in range(3, 10)]):
@@ -476,10 +480,59 @@ def write_markdown(path, args, plan, rows, table, complexity, noise, machine, co
         "Mean RMSE of the default over the %d scene(s): %.4f."
         % (len(default_rows), statistics.mean(r["rmse"] for r in default_rows)),
         "",
-    ]
+    ] + METHOD_NOTES
     with open(path + ".tmp", "w", encoding="utf-8") as f:
         f.write("\n".join(lines))
     os.replace(path + ".tmp", path)
+
+
+METHOD_NOTES = """## How it is measured
+
+`scripts/benchmark.sh [--quick] [--out DIR]` (default DIR `build/benchmark`; `--help` for the
+rest) runs `benchmarks/speed_error.py`, which writes `speed_error.csv`, `speed_error.png`,
+`complexity.csv`, `complexity.png` and this page into DIR; `--update-docs` copies them into
+`docs/`. The full run takes about an hour on 2 cores the first time (the reference renders,
+cached afterwards in `build/benchmark_kit`, keyed by the Blender scripts, Blender's version and
+the render settings) and about half an hour after that; `--quick` (3 scenes at 640x360, 256-spp
+references, fewer settings, one run each) about 5 minutes.
+
+The scenes (`scripts/blender/benchmark_scenes.py`, plain grey geometry built from scratch; AO
+distance = the radius, chosen as an artist would for each layout):
+
+| scene | what it tests | AO distance |
+|---|---|---|
+| contact | boxes and a sphere on a floor against a wall: contact shadows, a concave corner | 0.8 |
+| thin | a fence of 5 cm posts and rails 25 cm in front of a wall, free-standing 6 cm columns, a bench of slats | 0.5 |
+| cavity | a bookcase of 2 cm boards with 35 cm deep cells and an open crate in a room corner | 0.5 |
+| depth_range | objects 2.5 m from the camera against buildings up to 300 m away and the horizon | 1.0 |
+| ortho | steps, a grid of blocks, a torus and a sphere under an orthographic camera | 0.6 |
+| heavy | spheres, tori and a floor grid, about 9.4k triangles, each face split in four 0-5 times | 0.8 |
+
+- Ground truth: one Cycles render per scene and size with Depth, Normal, Combined (the beauty)
+  and the AO pass at 1024 spp at 640x360 and, by default, 256 spp at 1920x1080 (`--hd-samples
+  1024` takes about 17 minutes per scene on 2 cores; the noise figure above says what the
+  lower count costs: an independent noise of sigma adds in quadrature, so an RMSE of 0.05
+  against a reference with sigma = 0.01 reads 0.051).
+- Cycles as the alternative (`scripts/blender/cycles_ao_sweep.py`): the same scene rendered for
+  the AO pass alone, the fastest way that still writes a correct AO pass: no bounces, lights
+  hidden, a plain diffuse material override, only the AO pass (no Combined, Depth or Normal),
+  no denoising, no adaptive sampling, no persistent data, another seed than the reference. One
+  untimed warm-up render, then the sample counts 1, 2, 4, 8, 16, 64 in interleaved rounds;
+  each `bpy.ops.render.render()` call is timed (scene sync, BVH build, sampling; not the file
+  write). Its images are scored by the same code as ours. The smoke test checks that this
+  set-up's AO pass converges to the ground truth (bias under 0.02 at 64 spp).
+- libssao: every configuration in the table through the C API in one `build/bin/ssao_eval`
+  process per scene, interleaved rounds (A B C .. A B C ..), median; the time of
+  `ssao_job_run` alone (no file I/O). `seed-hemisphere` and `seed-sphere` are line-for-line
+  ports of the seed tutorials' code (`tests/reference/seed_ports.cpp`, one thread); `raymarch`
+  is the brute-force depth-buffer ray march (128 rays x 24 steps), roughly the accuracy floor
+  of any method that sees only the depth buffer (640x360 only).
+- Plots with Debian's `python3-matplotlib` (installed by `scripts/install_deps.sh`): the
+  standard Python plotting library, already packaged, nothing to download.
+
+Analytic-geometry accuracy and the Cycles test render of the test suite are in
+[accuracy.md](accuracy.md).
+""".splitlines()
 
 
 def complexity_lines(complexity):
@@ -509,6 +562,9 @@ def parse_args():
                         help="cache of the reference renders (default build/benchmark_kit)")
     parser.add_argument("--threads", type=int, default=os.cpu_count() or 1,
                         help="threads for libssao and Cycles (default: every core)")
+    parser.add_argument("--hd-samples", type=int, default=256,
+                        help="samples per pixel of the 1920x1080 ground truth (default 256; "
+                             "640x360 has 1024)")
     parser.add_argument("--kit-only", action="store_true",
                         help="only render (or find) the reference scenes")
     parser.add_argument("--update-docs", action="store_true",
@@ -526,6 +582,8 @@ def parse_args():
         args.size = (w, h)
     if args.threads < 1:
         parser.error("--threads must be positive")
+    if args.hd_samples < 1:
+        parser.error("--hd-samples must be positive")
     if not os.path.isfile(args.eval):
         fail("no %s: build the project first (scripts/setup.sh or scripts/build.sh)" % args.eval)
     if shutil.which(args.blender) is None:
@@ -542,7 +600,7 @@ def parse_args():
 
 def main():
     args = parse_args()
-    plan = Plan(args.quick, args.size)
+    plan = Plan(args.quick, args.size, args.hd_samples)
     start = time.perf_counter()
     blender_version = subprocess.run([args.blender, "--version"], stdout=subprocess.PIPE,
                                      stderr=subprocess.DEVNULL, text=True,

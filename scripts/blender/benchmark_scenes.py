@@ -31,7 +31,6 @@ import argparse
 import math
 import os
 import sys
-import traceback
 
 import bmesh
 import bpy
@@ -316,13 +315,4 @@ def main():
 
 
 if __name__ == "__main__":
-    try:
-        main()
-    except SystemExit:
-        raise
-    except BaseException:
-        traceback.print_exc()
-        print("benchmark_scenes: FAILED", file=sys.stderr)
-        sys.stdout.flush()
-        sys.stderr.flush()
-        sys.exit(1)
+    reference.run_script(main, "benchmark_scenes")

@@ -23,7 +23,6 @@ import os
 import statistics
 import sys
 import time
-import traceback
 
 import bpy
 
@@ -137,13 +136,4 @@ def main():
 
 
 if __name__ == "__main__":
-    try:
-        main()
-    except SystemExit:
-        raise
-    except BaseException:
-        traceback.print_exc()
-        print("cycles_ao_sweep: FAILED", file=sys.stderr)
-        sys.stdout.flush()
-        sys.stderr.flush()
-        sys.exit(1)
+    reference.run_script(main, "cycles_ao_sweep")

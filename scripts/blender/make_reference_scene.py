@@ -446,14 +446,20 @@ def main():
     render_reference(scene, cam_obj, args, prefix, args.scene_name or os.path.basename(prefix))
 
 
-if __name__ == "__main__":
+def run_script(main, name):
+    """Runs main() as a Blender script: on any error, the traceback and 'NAME: FAILED' on stderr
+    and exit status 1 (with --python-exit-code 1; Blender itself would carry on)."""
     try:
         main()
     except SystemExit:
         raise
     except BaseException:
         traceback.print_exc()
-        print("make_reference_scene: FAILED", file=sys.stderr)
+        print("%s: FAILED" % name, file=sys.stderr)
         sys.stdout.flush()
         sys.stderr.flush()
         sys.exit(1)
+
+
+if __name__ == "__main__":
+    run_script(main, "make_reference_scene")

@@ -81,7 +81,7 @@ const char* const kUsage =
     "Options:\n"
     "  --camera FILE        camera JSON (required)\n"
     "  --radius R           AO distance in scene units, as Cycles' (required)\n"
-    "  --method M           method to score (required)\n"
+    "  --method M           method to score (required unless --run is given)\n"
     "  --set NAME=VALUE     parameter of the method (repeatable); arrays as a,b,c\n"
     "  --run \"M N=V ...\"    one more method with its parameters, separated by spaces\n"
     "                       (repeatable; the first --run is the method when --method is not\n"
