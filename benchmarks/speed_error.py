@@ -19,6 +19,7 @@ Stages (each prints a line as it goes):
    OUT/performance.md, and per scene the equal-error speed-up over Cycles on stdout.
 """
 import argparse
+import csv
 import hashlib
 import json
 import math
@@ -112,6 +113,10 @@ def fail(message, status=1):
     sys.exit(status)
 
 
+class StepFailed(Exception):
+    """A render or an ssao_eval run failed: the scene it belongs to is reported and skipped."""
+
+
 def run_logged(command, log_path, what):
     """Runs `command`, its output to `log_path`; exits with the log's tail if it fails."""
     with open(log_path, "w", encoding="utf-8") as out:
@@ -119,8 +124,8 @@ def run_logged(command, log_path, what):
     if proc.returncode != 0:
         with open(log_path, encoding="utf-8", errors="replace") as f:
             tail = f.readlines()[-25:]
-        fail("%s failed (exit %d); the end of %s:\n%s"
-             % (what, proc.returncode, log_path, "".join(tail)))
+        raise StepFailed("%s failed (exit %d); the end of %s:\n%s"
+                         % (what, proc.returncode, log_path, "".join(tail)))
 
 
 def blender_command(blender, script, arguments):
@@ -144,9 +149,10 @@ def kit_key(blender_version, arguments):
 def kit_render(args, blender_version, scene, size, samples, seed=1, border=None):
     """The prefix of a cached reference render, rendering it first if it is not there."""
     arguments = ["--scene", scene, "--width", str(size[0]), "--height", str(size[1]),
-                 "--samples", str(samples), "--seed", str(seed), "--threads", str(args.threads)]
+                 "--samples", str(samples), "--seed", str(seed)]
     if border:
         arguments += ["--border", ",".join(str(v) for v in border)]
+    # The key leaves out the thread count: it changes the render's speed, not its pixels.
     name = "%s-%ds%d%s-%s" % (label(scene, size), samples, seed, "-part" if border else "",
                               kit_key(blender_version, arguments))
     folder = os.path.join(args.kit, name)
@@ -160,7 +166,8 @@ def kit_render(args, blender_version, scene, size, samples, seed=1, border=None)
     os.makedirs(partial)
     start = time.perf_counter()
     run_logged(blender_command(args.blender, KIT_SCRIPTS[0],
-                               arguments + ["--out", os.path.join(partial, "ref")]),
+                               arguments + ["--threads", str(args.threads),
+                                            "--out", os.path.join(partial, "ref")]),
                os.path.join(partial, "blender.log"), "rendering " + label(scene, size))
     shutil.rmtree(folder, ignore_errors=True)
     os.replace(partial, folder)  # complete renders only, under the final name
@@ -213,9 +220,8 @@ def run_eval(args, reference, runs, repeat, what):
     results = [dict(field.split("=", 1) for field in line.split(" "))
                for line in proc.stdout.splitlines() if line.startswith("scene=")]
     if proc.returncode != 0 or len(results) != len(runs):
-        fail("ssao_eval failed on %s (exit %d): %s\n%s%s" % (what, proc.returncode,
-                                                             " ".join(command), proc.stdout,
-                                                             proc.stderr))
+        raise StepFailed("ssao_eval failed on %s (exit %d): %s\n%s%s"
+                         % (what, proc.returncode, " ".join(command), proc.stdout, proc.stderr))
     return results
 
 
@@ -279,7 +285,10 @@ def cycles_time_to(rmse, cycles_rows):
     """Time Cycles needs to reach `rmse`, interpolated (log time against log RMSE) along its
     Pareto front; returns (seconds, relation) with relation '<=' or '>=' when `rmse` lies
     outside the measured range."""
-    front = pareto_front([(r["time_s"], r["rmse"]) for r in cycles_rows])
+    front = pareto_front([(r["time_s"], r["rmse"]) for r in cycles_rows
+                          if math.isfinite(r["rmse"]) and r["rmse"] > 0.0])
+    if not front or not math.isfinite(rmse):
+        return math.nan, "?"
     if rmse >= front[0][1]:
         return front[0][0], "<="
     if rmse <= front[-1][1]:
@@ -307,10 +316,12 @@ def speedups(rows):
 
 
 def write_csv(path, columns, rows):
-    with open(path + ".tmp", "w", encoding="utf-8") as f:
-        f.write(",".join(columns) + "\n")
+    """RFC 4180 CSV (a setting such as "samples=8,steps=3" is quoted), written atomically."""
+    with open(path + ".tmp", "w", encoding="utf-8", newline="") as f:
+        writer = csv.writer(f, lineterminator="\n")
+        writer.writerow(columns)
         for r in rows:
-            f.write(",".join(format_value(r[c]) for c in columns) + "\n")
+            writer.writerow([format_value(r[c]) for c in columns])
     os.replace(path + ".tmp", path)
 
 
@@ -414,13 +425,22 @@ def markdown_table(header, lines):
 
 
 def speedup_lines(table):
-    return [[s["scene"], "%.1f ms" % (1000 * s["time_s"]), "%.4f" % s["rmse"],
-             "%s %.2f s" % ("" if s["relation"] == "=" else s["relation"], s["cycles_s"]),
-             "%s%.1fx" % ("" if s["relation"] == "=" else s["relation"], s["speedup"])]
-            for s in table]
+    lines = []
+    for s in table:
+        if s["relation"] == "?":
+            cycles, speedup = "n/a", "n/a"
+        else:
+            relation = "" if s["relation"] == "=" else s["relation"] + " "
+            cycles = "%s%.2f s" % (relation, s["cycles_s"])
+            speedup = "%s%.1fx" % (relation, s["speedup"])
+        lines.append([s["scene"], "%.1f ms" % (1000 * s["time_s"]), "%.4f" % s["rmse"], cycles,
+                      speedup])
+    return lines
 
 
-def write_markdown(path, args, plan, rows, table, complexity, noise, machine, command):
+def write_markdown(path, images, args, plan, rows, table, complexity, noise, machine, command,
+                   failed):
+    """The report; `images` is the folder of the plots relative to it ("" or "images/")."""
     default_rows = [r for r in rows if r["setting"] == "default"]
     lines = [
         "# Performance: run time against error",
@@ -431,12 +451,12 @@ def write_markdown(path, args, plan, rows, table, complexity, noise, machine, co
         "",
         "RMSE and bias (mean of method - truth; positive = too little occlusion) are over the "
         "pixels that show geometry (depth finite and below 0.9 x clip_end), against Cycles' AO "
-        "pass at %s. Its own per-pixel noise, measured as the difference of a second render "
-        "with another seed over %d pixels of `%s`: %s. "
+        "pass at %s. Its own per-pixel noise (RMS), measured as the difference of a second "
+        "render of the middle of `%s` with another seed, divided by sqrt(2): %s. "
         % (", ".join("%d spp at %dx%d" % (n, w, h)
                      for (w, h), n in sorted(plan.reference_samples.items())),
-           noise[0][2] if noise else 0, plan.noise_scene,
-           ", ".join("%.4f at %s" % (n, size) for n, size, _ in noise)),
+           plan.noise_scene,
+           ", ".join("%.4f at %s (%d pixels)" % entry for entry in noise)),
         "Times are medians of %d interleaved run(s) of the AO computation alone (libssao "
         "through the C API, %d threads; the seed ports on one thread) and of the Cycles "
         "render call (scene sync, BVH build and sampling; %d threads). A Cycles row with "
@@ -452,7 +472,7 @@ def write_markdown(path, args, plan, rows, table, complexity, noise, machine, co
         markdown_table(["scene", "libssao default", "RMSE", "Cycles to the same RMSE",
                         "speed-up"], speedup_lines(table)),
         "",
-        "![run time against RMSE](images/speed_error.png)",
+        "![run time against RMSE](%sspeed_error.png)" % images,
         "",
         "## Scene complexity",
         "",
@@ -465,7 +485,7 @@ def write_markdown(path, args, plan, rows, table, complexity, noise, machine, co
                        + ["libssao default"],
                        complexity_lines(complexity)),
         "",
-        "![time against triangle count](images/complexity.png)",
+        "![time against triangle count](%scomplexity.png)" % images,
         "",
         "## Every row",
         "",
@@ -481,6 +501,9 @@ def write_markdown(path, args, plan, rows, table, complexity, noise, machine, co
         % (len(default_rows), statistics.mean(r["rmse"] for r in default_rows)),
         "",
     ] + METHOD_NOTES
+    if failed:
+        lines[2:2] = ["", "**Incomplete run: %s failed (see the run's output).**"
+                      % ", ".join(failed)]
     with open(path + ".tmp", "w", encoding="utf-8") as f:
         f.write("\n".join(lines))
     os.replace(path + ".tmp", path)
@@ -504,7 +527,7 @@ distance = the radius, chosen as an artist would for each layout):
 | contact | boxes and a sphere on a floor against a wall: contact shadows, a concave corner | 0.8 |
 | thin | a fence of 5 cm posts and rails 25 cm in front of a wall, free-standing 6 cm columns, a bench of slats | 0.5 |
 | cavity | a bookcase of 2 cm boards with 35 cm deep cells and an open crate in a room corner | 0.5 |
-| depth_range | objects 2.5 m from the camera against buildings up to 300 m away and the horizon | 1.0 |
+| depth_range | objects 3 to 5 m from the camera against buildings up to 300 m away and the horizon | 1.0 |
 | ortho | steps, a grid of blocks, a torus and a sphere under an orthographic camera | 0.6 |
 | heavy | spheres, tori and a floor grid, about 9.4k triangles, each face split in four 0-5 times | 0.8 |
 
@@ -531,7 +554,7 @@ distance = the radius, chosen as an artist would for each layout):
   standard Python plotting library, already packaged, nothing to download.
 
 Analytic-geometry accuracy and the Cycles test render of the test suite are in
-[accuracy.md](accuracy.md).
+`docs/accuracy.md`.
 """.splitlines()
 
 
@@ -598,46 +621,84 @@ def parse_args():
     return args
 
 
-def main():
-    args = parse_args()
-    plan = Plan(args.quick, args.size, args.hd_samples)
-    start = time.perf_counter()
-    blender_version = subprocess.run([args.blender, "--version"], stdout=subprocess.PIPE,
-                                     stderr=subprocess.DEVNULL, text=True,
-                                     check=False).stdout.splitlines()[0].strip()
-    os.makedirs(args.kit, exist_ok=True)
-    references = {(scene, size): kit_render(args, blender_version, scene, size,
-                                            plan.reference_samples[size])
-                  for scene, size in plan.scenes}
-    noise_parts = {size: kit_render(args, blender_version, plan.noise_scene, size,
-                                    plan.reference_samples[size], seed=2, border=NOISE_BORDER)
-                   for size in plan.reference_samples}
-    if args.kit_only:
-        log("kit ready in %s (%.0f s)" % (args.kit, time.perf_counter() - start))
-        return 0
-
-    os.makedirs(args.out, exist_ok=True)
-    noise = []
-    for size, part in sorted(noise_parts.items()):
-        sigma, pixels = reference_noise(args, references[(plan.noise_scene, size)], part)
-        noise.append((sigma, "%dx%d" % size, pixels))
-    rows, complexity = [], []
+def build_kit(args, plan, blender_version):
+    """The reference renders: {(scene, size): prefix}, {size: noise-check prefix}, failures."""
+    references, noise_parts, failed = {}, {}, []
     for scene, size in plan.scenes:
+        try:
+            references[(scene, size)] = kit_render(args, blender_version, scene, size,
+                                                   plan.reference_samples[size])
+        except StepFailed as error:
+            log("FAILED: %s" % error)
+            failed.append(label(scene, size))
+    for size in plan.reference_samples:
+        try:
+            noise_parts[size] = kit_render(args, blender_version, plan.noise_scene, size,
+                                           plan.reference_samples[size], seed=2,
+                                           border=NOISE_BORDER)
+        except StepFailed as error:
+            log("FAILED (the noise check): %s" % error)
+    return references, noise_parts, failed
+
+
+def measure(args, plan, references):
+    """Cycles sweeps and ssao_eval runs, scene by scene: (rows, complexity rows, failures). A
+    scene that fails is reported and skipped; the others are still measured."""
+    rows, complexity, failed = [], [], []
+    for (scene, size), reference in references.items():
         levels = plan.heavy_levels if scene == "heavy" else [0]
-        sweeps = [(level, cycles_sweep(args, plan, scene, size, level)) for level in levels]
-        scene_rows = measure_scene(args, plan, references[(scene, size)], scene, size, sweeps)
+        try:
+            sweeps = [(level, cycles_sweep(args, plan, scene, size, level)) for level in levels]
+            scene_rows = measure_scene(args, plan, reference, scene, size, sweeps)
+        except StepFailed as error:
+            log("FAILED: %s" % error)
+            failed.append(label(scene, size))
+            continue
         rows += scene_rows
         if scene == "heavy":
             ours = next(r for r in scene_rows if r["setting"] == "default")
             for level, sweep in sweeps:
+                common = {"size": "%dx%d" % size, "level": level,
+                          "triangles": sweep["triangles"]}
                 for run in sweep["runs"]:
-                    complexity.append({"size": "%dx%d" % size, "level": level,
-                                       "triangles": sweep["triangles"], "method": "cycles",
-                                       "samples": run["samples"], "time_s": run["median_s"]})
-                complexity.append({"size": "%dx%d" % size, "level": level,
-                                   "triangles": sweep["triangles"], "method": "libssao",
-                                   "samples": 0, "time_s": ours["time_s"]})
+                    complexity.append(dict(common, method="cycles", samples=run["samples"],
+                                           time_s=run["median_s"]))
+                complexity.append(dict(common, method="libssao", samples=0,
+                                       time_s=ours["time_s"]))
+    return rows, complexity, failed
 
+
+def main():
+    args = parse_args()
+    plan = Plan(args.quick, args.size, args.hd_samples)
+    start = time.perf_counter()
+    version = subprocess.run([args.blender, "--version"], stdout=subprocess.PIPE,
+                             stderr=subprocess.DEVNULL, text=True, check=False).stdout.split("\n")
+    blender_version = version[0].strip()
+    if not blender_version.startswith("Blender"):
+        fail("'%s --version' does not say which Blender it is" % args.blender)
+    os.makedirs(args.kit, exist_ok=True)
+    references, noise_parts, failed = build_kit(args, plan, blender_version)
+    if args.kit_only:
+        if failed:
+            fail("the kit is incomplete: %s failed" % ", ".join(failed))
+        log("kit ready in %s (%.0f s)" % (args.kit, time.perf_counter() - start))
+        return 0
+
+    noise = []
+    for size, part in sorted(noise_parts.items()):
+        if (plan.noise_scene, size) in references:
+            try:
+                sigma, pixels = reference_noise(args, references[(plan.noise_scene, size)], part)
+                noise.append((sigma, "%dx%d" % size, pixels))
+            except StepFailed as error:
+                log("FAILED (the noise check): %s" % error)
+    rows, complexity, failed_scenes = measure(args, plan, references)
+    failed += failed_scenes
+    if not rows:
+        fail("nothing was measured: %s failed" % ", ".join(failed))
+
+    os.makedirs(args.out, exist_ok=True)
     write_csv(os.path.join(args.out, "speed_error.csv"), CSV_COLUMNS, rows)
     write_csv(os.path.join(args.out, "complexity.csv"),
               ["size", "level", "triangles", "method", "samples", "time_s"], complexity)
@@ -650,15 +711,14 @@ def main():
     machine = machine_description(args, blender_version)
     command = "scripts/benchmark.sh" + (" --quick" if args.quick else "") + (
         " --size %dx%d" % args.size if args.size else "")
-    write_markdown(os.path.join(args.out, "performance.md"), args, plan, rows, table,
-                   complexity, noise, machine, command)
+    report = (args, plan, rows, table, complexity, noise, machine)
+    write_markdown(os.path.join(args.out, "performance.md"), "", *report, command, failed)
     if args.update_docs:
-        images = os.path.join(REPO_ROOT, "docs", "images")
-        shutil.copy(os.path.join(args.out, "speed_error.png"), images)
-        if complexity:
-            shutil.copy(os.path.join(args.out, "complexity.png"), images)
-        shutil.copy(os.path.join(args.out, "performance.md"),
-                    os.path.join(REPO_ROOT, "docs", "performance.md"))
+        for name in ("speed_error.png", "complexity.png"):
+            if os.path.isfile(os.path.join(args.out, name)):
+                shutil.copy(os.path.join(args.out, name), os.path.join(REPO_ROOT, "docs", "images"))
+        write_markdown(os.path.join(REPO_ROOT, "docs", "performance.md"), "images/", *report,
+                       command + " --update-docs", failed)
 
     print()
     print("Equal-error speed-up over Cycles' AO pass (%s):" % machine)
@@ -672,6 +732,8 @@ def main():
     print()
     log("wrote %s/{speed_error.csv,speed_error.png,complexity.csv,complexity.png,"
         "performance.md} in %.0f s" % (args.out, time.perf_counter() - start))
+    if failed:
+        fail("incomplete: %s failed (the files hold the rest)" % ", ".join(failed))
     return 0
 
 

@@ -9,7 +9,7 @@ Each scene is a layout of plain grey geometry chosen for one way SSAO goes wrong
                    thin columns: occluders much thinner than the AO distance.
 * ``cavity``       a bookcase of 2 cm boards with deep cells and an open crate in a room
                    corner: enclosed spaces.
-* ``depth_range``  objects 1.5 m from the camera against buildings up to 300 m away and a
+* ``depth_range``  objects 3 to 5 m from the camera against buildings up to 300 m away and a
                    horizon: projected AO radii from hundreds of pixels to about two.
 * ``ortho``        blocks, steps, a torus and a sphere under an orthographic camera.
 * ``heavy``        spheres, tori and a floor grid of about 10k triangles, flat shaded, whose
@@ -171,7 +171,7 @@ def layout_cavity(scene, mat):
 def layout_depth_range(scene, mat):
     reference.add_quad(scene, "Ground", [(-400.0, -10.0, 0.0), (400.0, -10.0, 0.0),
                                          (400.0, 400.0, 0.0), (-400.0, 400.0, 0.0)], mat)
-    # Near: a box, a sphere and a step 2.5 to 5 m from the camera.
+    # Near: a box, a sphere and a step 3 to 5.5 m from the camera.
     reference.add_box(scene, "NearBox", (0.5, 0.5, 0.5), (-0.6, 2.2, 0.25), mat, 30.0)
     reference.add_sphere(scene, "NearSphere", 0.3, (0.5, 2.8, 0.3), mat)
     reference.add_box(scene, "Step", (2.0, 0.6, 0.2), (0.0, 4.5, 0.1), mat)

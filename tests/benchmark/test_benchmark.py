@@ -110,8 +110,9 @@ class QuickRunTest(unittest.TestCase):
         with open(os.path.join(self.out, "performance.md"), encoding="utf-8") as f:
             text = f.read()
         self.assertIn("scripts/benchmark.sh --quick --size %s" % SIZE, text)
-        self.assertIn("images/speed_error.png", text)
-        self.assertIn("images/complexity.png", text)
+        # The plots sit beside this copy of the page (docs/performance.md links images/).
+        self.assertIn("(speed_error.png)", text)
+        self.assertIn("(complexity.png)", text)
         self.assertIn("Equal-error speed-up over Cycles' AO pass", self.proc.stdout)
         for scene in SCENES:
             self.assertIn("| %s |" % scene, text)
@@ -159,6 +160,22 @@ class SpeedupTest(unittest.TestCase):
     def test_pareto_front(self):
         front = speed_error.pareto_front([(r["time_s"], r["rmse"]) for r in self.CYCLES])
         self.assertEqual(front, [(1.0, 0.4), (2.0, 0.2), (4.0, 0.1)])
+
+    def test_csv_quotes_settings_with_commas(self):
+        path = os.path.join(OPTIONS["scratch"], "quoted.csv")
+        rows = [{"scene": "s@64x36", "method": "hemisphere", "setting": label, "threads": 2,
+                 "time_s": 0.5, "rmse": 0.05, "bias": -0.01}
+                for _, label, _ in speed_error.LIBRARY_FULL]
+        speed_error.write_csv(path, speed_error.CSV_COLUMNS, rows)
+        with open(path, encoding="utf-8", newline="") as f:
+            back = list(csv.DictReader(f))
+        self.assertEqual([r["setting"] for r in back], [r["setting"] for r in rows])
+        self.assertTrue(all(r["rmse"] == "0.05" and None not in r.values() for r in back))
+        self.assertIn("samples=8,steps=3", [r["setting"] for r in back])
+
+    def test_unmeasurable_rmse(self):
+        self.assertEqual(speed_error.cycles_time_to(float("nan"), self.CYCLES)[1], "?")
+        self.assertEqual(speed_error.cycles_time_to(0.0, self.CYCLES), (4.0, ">="))
 
     def test_speedups_per_scene(self):
         rows = [dict(r, scene="s", method="cycles", setting="samples=1") for r in self.CYCLES]

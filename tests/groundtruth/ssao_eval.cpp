@@ -62,7 +62,8 @@ const char* const kUsage =
     "over the pixels whose depth is finite, > 0 and < 0.9 * clip_end. mean_error is the mean\n"
     "of (method - truth): positive means too little occlusion. time_ms is the median of\n"
     "--repeat runs of the AO computation alone (no file I/O), min_ms the fastest; the methods\n"
-    "run in interleaved rounds (A B C A B C ...). An image method is not timed (nan).\n"
+    "run in interleaved rounds (A B C A B C ...) after one untimed round. An image method is\n"
+    "not timed (nan).\n"
     "\n"
     "Methods:\n"
     "  ssao             libssao through its C API; world-space normals from the Normal pass\n"
@@ -74,7 +75,8 @@ const char* const kUsage =
     "  raymarch         brute-force ray march through the depth buffer (--set rays=N,\n"
     "                   steps=N, thickness=F (fraction of radius), seed=N)\n"
     "  image            an AO image from a file, e.g. Cycles' AO pass at fewer samples\n"
-    "                   (--set path=FILE; channel=NAME, default <layer>.AO.R or AO;\n"
+    "                   (--set path=FILE; channel=NAME, default the one channel AO, AO.R\n"
+    "                   or <layer>.AO.R;\n"
     "                   region=MIN_X,MAX_X,MIN_Y,MAX_Y scores only that part of the frame, in\n"
     "                   fractions measured from the bottom left, as Blender's render border)\n"
     "\n"
@@ -152,6 +154,14 @@ double parse_double(const std::string& text, const std::string& what) {
     throw UsageError(what + ": expected a finite number, got '" + text + "'");
   }
   return value;
+}
+
+std::vector<double> parse_double_list(const std::string& text, const std::string& what) {
+  std::vector<double> values;
+  std::stringstream list(text);
+  std::string item;
+  while (std::getline(list, item, ',')) values.push_back(parse_double(item, what));
+  return values;
 }
 
 long long parse_integer(const std::string& text, const std::string& what, long long lo,
@@ -392,14 +402,9 @@ void set_core_param(ssao_io::Job& job, const std::vector<ssao_param_desc>& table
       case SSAO_PARAM_STRING:
         job.set(s.name, s.value);
         break;
-      case SSAO_PARAM_FLOATS: {
-        std::vector<double> values;
-        std::stringstream list(s.value);
-        std::string item;
-        while (std::getline(list, item, ',')) values.push_back(parse_double(item, where));
-        job.set(s.name, values);
+      case SSAO_PARAM_FLOATS:
+        job.set(s.name, parse_double_list(s.value, where));
         break;
-      }
     }
   } catch (const ssao_io::CoreError&) {
     throw UsageError(where + ": " + ssao_last_error());
@@ -484,9 +489,7 @@ Method make_image_method(const std::vector<Setting>& settings, const std::string
     } else if (s.name == "channel") {
       channel = s.value;
     } else if (s.name == "region") {
-      std::stringstream list(s.value);
-      std::string item;
-      while (std::getline(list, item, ',')) region.push_back(parse_double(item, where));
+      region = parse_double_list(s.value, where);
       if (region.size() != 4 || region[0] >= region[1] || region[2] >= region[3] ||
           *std::min_element(region.begin(), region.end()) < 0.0 ||
           *std::max_element(region.begin(), region.end()) > 1.0) {
@@ -511,16 +514,22 @@ Method make_image_method(const std::vector<Setting>& settings, const std::string
   if (!channel.empty()) {
     index = ssao_io::require_channel(image, channel, path);
   } else {
-    for (int c = 0; c < image.channels() && index < 0; ++c) {
+    // The AO: a channel "AO", "AO.R" or "<layer>.AO.R"; with several, channel= must choose.
+    std::vector<int> found;
+    for (int c = 0; c < image.channels(); ++c) {
       const std::string& name = image.channel_names[static_cast<size_t>(c)];
-      if (name == "AO" || (name.size() > 5 && name.compare(name.size() - 5, 5, ".AO.R") == 0)) {
-        index = c;
+      if (name == "AO" || name == "AO.R" ||
+          (name.size() > 5 && name.compare(name.size() - 5, 5, ".AO.R") == 0)) {
+        found.push_back(c);
       }
     }
-    if (index < 0) {
-      throw ssao_io::Error("'" + path + "' has no channel AO or <layer>.AO.R; its channels: " +
+    if (found.size() != 1) {
+      throw ssao_io::Error("'" + path + "' has " + (found.empty() ? "no" : "more than one") +
+                           " AO channel (AO, AO.R or <layer>.AO.R): choose one with "
+                           "channel=NAME; its channels: " +
                            ssao_io::join_names(image.channel_names));
     }
+    index = found.front();
   }
   *m.ao = ssao_io::extract_channels(image, {index});
   if (!region.empty()) {
@@ -654,9 +663,13 @@ Method make_method(const std::string& name, const std::vector<Setting>& settings
   return m;
 }
 
-// Wall times in milliseconds of `repeat` runs of every timed method, in interleaved rounds.
+// Wall times in milliseconds of `repeat` runs of every timed method, in interleaved rounds,
+// after one untimed round (first-touch page faults, thread start-up).
 std::vector<std::vector<double>> time_interleaved(const std::vector<Method>& methods, int repeat) {
   std::vector<std::vector<double>> times(methods.size());
+  for (const Method& m : methods) {
+    if (m.run) m.run();
+  }
   for (int round = 0; round < repeat; ++round) {
     for (size_t i = 0; i < methods.size(); ++i) {
       if (!methods[i].run) continue;
