@@ -339,6 +339,17 @@ def pyplot():
     return plt
 
 
+def series_name(row):
+    """The curve a library row belongs to: its variant, plus any setting other than the sample
+    count ("hemisphere", "hemisphere steps=3", "sphere classic"), so that a curve varies the
+    samples only. Other methods are one curve each."""
+    if row["method"] not in ("hemisphere", "sphere"):
+        return row["method"]
+    extra = [part for part in row["setting"].split(",")
+             if part != "default" and not part.startswith("samples=")]
+    return " ".join([row["method"]] + extra)
+
+
 def plot_speed_error(path, rows, truth):
     plt = pyplot()
     scenes = [s for s in dict.fromkeys(r["scene"] for r in rows) if "-L" not in s]
@@ -350,12 +361,12 @@ def plot_speed_error(path, rows, truth):
               "raymarch": ("C5", "P")}
     for ax, scene in zip(axes.flat, scenes):
         mine = [r for r in rows if r["scene"] == scene]
-        for method, (colour, marker) in styles.items():
-            points = sorted((r["time_s"], r["rmse"]) for r in mine if r["method"] == method)
-            if points:
-                ax.plot([p[0] for p in points], [p[1] for p in points], marker=marker,
-                        color=colour, linestyle="-" if len(points) > 1 else "none",
-                        label=method, markersize=5)
+        for name in dict.fromkeys(series_name(r) for r in mine):
+            colour, marker = styles.get(name.split(" ")[0], ("k", "x"))
+            points = sorted((r["time_s"], r["rmse"]) for r in mine if series_name(r) == name)
+            ax.plot([p[0] for p in points], [p[1] for p in points], marker=marker,
+                    color=colour, linestyle="-" if len(points) > 1 else "none", label=name,
+                    markersize=5, markerfacecolor=colour if name in styles else "none")
         for r in mine:
             if r["setting"] == "default":
                 ax.plot([r["time_s"]], [r["rmse"]], marker="*", color="k", markersize=13,
@@ -366,12 +377,13 @@ def plot_speed_error(path, rows, truth):
         ax.set_xscale("log")
         ax.set_title(scene)
         ax.set_xlabel("run time (s, log)")
-        ax.set_ylabel("RMSE against %s" % truth)
+        ax.set_ylabel("RMSE")
         ax.grid(True, which="both", alpha=0.3)
     for ax in list(axes.flat)[len(scenes):]:
         ax.axis("off")
     axes.flat[0].legend(fontsize=7)
-    fig.tight_layout()
+    fig.suptitle("Run time against RMSE (ground truth: %s; lower left is better)" % truth)
+    fig.tight_layout(rect=(0.0, 0.0, 1.0, 1.0 - 0.3 / (4.0 * lines)))
     fig.savefig(path, dpi=90)
     plt.close(fig)
 
@@ -514,10 +526,10 @@ METHOD_NOTES = """## How it is measured
 `scripts/benchmark.sh [--quick] [--out DIR]` (default DIR `build/benchmark`; `--help` for the
 rest) runs `benchmarks/speed_error.py`, which writes `speed_error.csv`, `speed_error.png`,
 `complexity.csv`, `complexity.png` and this page into DIR; `--update-docs` copies them into
-`docs/`. The full run takes about an hour on 2 cores the first time (the reference renders,
-cached afterwards in `build/benchmark_kit`, keyed by the Blender scripts, Blender's version and
-the render settings) and about half an hour after that; `--quick` (3 scenes at 640x360, 256-spp
-references, fewer settings, one run each) about 5 minutes.
+`docs/`. On 2 cores the full run takes about 26 minutes, plus about 40 minutes the first time
+for the reference renders (cached in `build/benchmark_kit`, keyed by the Blender scripts,
+Blender's version and the render settings); `--quick` (3 scenes at 640x360, 256-spp
+references, fewer settings, one run each) about 2 minutes the first time, 40 s after that.
 
 The scenes (`scripts/blender/benchmark_scenes.py`, plain grey geometry built from scratch; AO
 distance = the radius, chosen as an artist would for each layout):
@@ -576,7 +588,7 @@ def parse_args():
         description="Run time against error of libssao, the seed tutorial code and Cycles' AO "
                     "pass on reference scenes rendered by Blender (see docs/performance.md).")
     parser.add_argument("--quick", action="store_true",
-                        help="3 scenes at 640x360, fewer settings, one run each (about 5 min)")
+                        help="3 scenes at 640x360, fewer settings, one run each (about 2 min)")
     parser.add_argument("--out", default=os.path.join(REPO_ROOT, "build", "benchmark"),
                         help="output folder (default build/benchmark)")
     parser.add_argument("--size", default=None, metavar="WxH",
