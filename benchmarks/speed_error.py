@@ -450,6 +450,14 @@ def speedup_lines(table):
     return lines
 
 
+def rmse_by_size(rows):
+    """{"640x360": [rmse, ...], ...} in the order the sizes first appear."""
+    by_size = {}
+    for r in rows:
+        by_size.setdefault(r["scene"].split("@")[1], []).append(r["rmse"])
+    return by_size
+
+
 def write_markdown(path, images, args, plan, rows, table, complexity, noise, machine, command,
                    failed):
     """The report; `images` is the folder of the plots relative to it ("" or "images/")."""
@@ -509,8 +517,9 @@ def write_markdown(path, images, args, plan, rows, table, complexity, noise, mac
                          r["threads"], "%.1f" % (1000 * r["time_s"]), "%.4f" % r["rmse"],
                          "%+.4f" % r["bias"]] for r in rows]),
         "",
-        "Mean RMSE of the default over the %d scene(s): %.4f."
-        % (len(default_rows), statistics.mean(r["rmse"] for r in default_rows)),
+        "Mean RMSE of the default: %s." % "; ".join(
+            "%.4f over the %d scene(s) at %s" % (statistics.mean(errors), len(errors), size)
+            for size, errors in rmse_by_size(default_rows).items()),
         "",
     ] + METHOD_NOTES
     if failed:
