@@ -43,18 +43,6 @@ import make_reference_scene as reference  # noqa: E402
 # ---------------------------------------------------------------------------
 # Shapes the layouts need beyond make_reference_scene's boxes, quads and spheres
 
-def add_bmesh_object(scene, name, bm, material, smooth):
-    mesh = bpy.data.meshes.new(name)
-    bm.to_mesh(mesh)
-    bm.free()
-    for poly in mesh.polygons:
-        poly.use_smooth = smooth
-    mesh.materials.append(material)
-    obj = bpy.data.objects.new(name, mesh)
-    scene.collection.objects.link(obj)
-    return obj
-
-
 def add_cylinder(scene, name, radius, height, base_center, material, segments=16):
     """An upright closed cylinder standing on base_center."""
     bm = bmesh.new()
@@ -63,7 +51,7 @@ def add_cylinder(scene, name, radius, height, base_center, material, segments=16
                           radius1=radius, radius2=radius, depth=height)
     bmesh.ops.translate(bm, vec=Vector(base_center) + Vector((0.0, 0.0, 0.5 * height)),
                         verts=bm.verts)
-    return add_bmesh_object(scene, name, bm, material, smooth=True)
+    return reference.add_bmesh_object(scene, name, bm, material, smooth=True)
 
 
 def add_torus(scene, name, major, minor, center, material, rotation=None, segments=48,

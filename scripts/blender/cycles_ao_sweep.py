@@ -78,10 +78,7 @@ def configure_fast_ao(scene, layer, args):
     r.use_compositing = False
     r.use_sequencer = False
     r.film_transparent = False
-    img = r.image_settings
-    img.file_format = "OPEN_EXR_MULTILAYER"
-    img.color_depth = "32"
-    img.exr_codec = "ZIP"
+    reference.use_multilayer_exr(r.image_settings)
     layer.use_pass_combined = False
     layer.use_pass_z = False
     layer.use_pass_normal = False

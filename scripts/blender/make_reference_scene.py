@@ -165,12 +165,9 @@ def add_box(scene, name, size, center, material, rotation_z_deg=0.0):
     return add_mesh_object(scene, name, verts, faces, material)
 
 
-def add_sphere(scene, name, radius, center, material, segments=48, rings=24, smooth=True):
+def add_bmesh_object(scene, name, bm, material, smooth):
+    """An object made of the bmesh `bm` (which is freed)."""
     mesh = bpy.data.meshes.new(name)
-    bm = bmesh.new()
-    # bmesh's create_uvsphere takes 'radius' since Blender 3.0 ('diameter' before).
-    bmesh.ops.create_uvsphere(bm, u_segments=segments, v_segments=rings, radius=radius)
-    bmesh.ops.translate(bm, vec=Vector(center), verts=bm.verts)
     bm.to_mesh(mesh)
     bm.free()
     for poly in mesh.polygons:
@@ -179,6 +176,14 @@ def add_sphere(scene, name, radius, center, material, segments=48, rings=24, smo
     obj = bpy.data.objects.new(name, mesh)
     scene.collection.objects.link(obj)
     return obj
+
+
+def add_sphere(scene, name, radius, center, material, segments=48, rings=24, smooth=True):
+    bm = bmesh.new()
+    # bmesh's create_uvsphere takes 'radius' since Blender 3.0 ('diameter' before).
+    bmesh.ops.create_uvsphere(bm, u_segments=segments, v_segments=rings, radius=radius)
+    bmesh.ops.translate(bm, vec=Vector(center), verts=bm.verts)
+    return add_bmesh_object(scene, name, bm, material, smooth)
 
 
 def build_geometry(scene):
@@ -286,6 +291,14 @@ ENGINES = {
 }
 
 
+def use_multilayer_exr(img):
+    """Image settings that write every pass losslessly: multilayer EXR, 32-bit float, ZIP."""
+    img.file_format = "OPEN_EXR_MULTILAYER"
+    img.color_depth = "32"
+    img.exr_codec = "ZIP"
+    return img
+
+
 def configure_render(scene, args, exr_path):
     r = scene.render
     r.resolution_x = args.width
@@ -317,10 +330,7 @@ def configure_render(scene, args, exr_path):
     r.use_stamp_scene = True
     r.use_stamp_lens = False
 
-    img = r.image_settings
-    img.file_format = "OPEN_EXR_MULTILAYER"
-    img.color_depth = "32"
-    img.exr_codec = "ZIP"
+    img = use_multilayer_exr(r.image_settings)
     if hasattr(img, "use_preview"):
         img.use_preview = False
     # The path already ends in .exr; with the extension option on, Blender keeps it.
