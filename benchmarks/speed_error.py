@@ -72,7 +72,6 @@ class Plan:
     """What a run measures: the full benchmark or --quick."""
 
     def __init__(self, quick, size, hd_samples):
-        self.quick = quick
         if quick:
             self.scenes = [("contact", SD), ("thin", SD), ("heavy", SD)]
             self.reference_samples = {SD: 256}
@@ -118,7 +117,8 @@ class StepFailed(Exception):
 
 
 def run_logged(command, log_path, what):
-    """Runs `command`, its output to `log_path`; exits with the log's tail if it fails."""
+    """Runs `command`, its output to `log_path`; raises StepFailed with the log's tail if it
+    fails."""
     with open(log_path, "w", encoding="utf-8") as out:
         proc = subprocess.run(command, stdout=out, stderr=subprocess.STDOUT, check=False)
     if proc.returncode != 0:
@@ -436,7 +436,8 @@ def markdown_table(header, lines):
     return "\n".join(out)
 
 
-def speedup_lines(table):
+def speedup_table(table):
+    """The equal-error speed-up per scene, as a Markdown table."""
     lines = []
     for s in table:
         if s["relation"] == "?":
@@ -447,7 +448,14 @@ def speedup_lines(table):
             speedup = "%s%.1fx" % (relation, s["speedup"])
         lines.append([s["scene"], "%.1f ms" % (1000 * s["time_s"]), "%.4f" % s["rmse"], cycles,
                       speedup])
-    return lines
+    return markdown_table(["scene", "libssao default", "RMSE", "Cycles to the same RMSE",
+                           "speed-up"], lines)
+
+
+def ground_truth(plan):
+    """"1024 spp at 640x360, 256 spp at 1920x1080": the reference renders' samples."""
+    return ", ".join("%d spp at %dx%d" % (n, w, h)
+                     for (w, h), n in sorted(plan.reference_samples.items()))
 
 
 def rmse_by_size(rows):
@@ -473,9 +481,7 @@ def write_markdown(path, images, args, plan, rows, table, complexity, noise, mac
         "pixels that show geometry (depth finite and below 0.9 x clip_end), against Cycles' AO "
         "pass at %s. Its own per-pixel noise (RMS), measured as the difference of a second "
         "render of the middle of `%s` with another seed, divided by sqrt(2): %s. "
-        % (", ".join("%d spp at %dx%d" % (n, w, h)
-                     for (w, h), n in sorted(plan.reference_samples.items())),
-           plan.noise_scene,
+        % (ground_truth(plan), plan.noise_scene,
            ", ".join("%.4f at %s (%d pixels)" % entry for entry in noise)),
         "Times are medians of %d interleaved run(s) of the AO computation alone (libssao "
         "through the C API, %d threads; the seed ports on one thread) and of the Cycles "
@@ -489,8 +495,7 @@ def write_markdown(path, images, args, plan, rows, table, complexity, noise, mac
         "log RMSE, along its Pareto front) over our default's time. `<=` means Cycles at 1 "
         "sample per pixel is already as accurate, so its 1-spp time is an upper bound.",
         "",
-        markdown_table(["scene", "libssao default", "RMSE", "Cycles to the same RMSE",
-                        "speed-up"], speedup_lines(table)),
+        speedup_table(table),
         "",
         "![run time against RMSE](%sspeed_error.png)" % images,
         "",
@@ -501,9 +506,7 @@ def write_markdown(path, images, args, plan, rows, table, complexity, noise, mac
         "libssao reads only the passes, so its time is the one measured on the scene."
         % max(plan.heavy_levels),
         "",
-        markdown_table(["triangles"] + ["Cycles %d spp" % n for n in CYCLES_SAMPLES]
-                       + ["libssao default"],
-                       complexity_lines(complexity)),
+        complexity_table(complexity),
         "",
         "![time against triangle count](%scomplexity.png)" % images,
         "",
@@ -579,14 +582,16 @@ Analytic-geometry accuracy and the Cycles test render of the test suite are in
 """.splitlines()
 
 
-def complexity_lines(complexity):
+def complexity_table(complexity):
+    """Run time against triangle count, as a Markdown table."""
     lines = []
     for triangles in sorted({r["triangles"] for r in complexity}):
         mine = {r["samples"]: r["time_s"] for r in complexity if r["triangles"] == triangles}
         lines.append(["{:,}".format(triangles)]
                      + ["%.2f s" % mine[n] if n in mine else "" for n in CYCLES_SAMPLES]
                      + ["%.1f ms" % (1000 * mine[0])])
-    return lines
+    return markdown_table(["triangles"] + ["Cycles %d spp" % n for n in CYCLES_SAMPLES]
+                          + ["libssao default"], lines)
 
 
 # ---------------------------------------------------------------------------------------------
@@ -724,8 +729,7 @@ def main():
     write_csv(os.path.join(args.out, "complexity.csv"),
               ["size", "level", "triangles", "method", "samples", "time_s"], complexity)
     plot_speed_error(os.path.join(args.out, "speed_error.png"), rows,
-                     "Cycles' AO pass at " + ", ".join("%d spp (%dx%d)" % (n, w, h) for (w, h), n
-                                                       in sorted(plan.reference_samples.items())))
+                     "Cycles' AO pass at " + ground_truth(plan))
     if complexity:
         plot_complexity(os.path.join(args.out, "complexity.png"), complexity)
     table = speedups(rows)
@@ -743,13 +747,11 @@ def main():
 
     print()
     print("Equal-error speed-up over Cycles' AO pass (%s):" % machine)
-    print(markdown_table(["scene", "libssao default", "RMSE", "Cycles to the same RMSE",
-                          "speed-up"], speedup_lines(table)))
+    print(speedup_table(table))
     if complexity:
         print()
         print("Scene complexity (heavy scene, %s):" % complexity[0]["size"])
-        print(markdown_table(["triangles"] + ["Cycles %d spp" % n for n in CYCLES_SAMPLES]
-                             + ["libssao default"], complexity_lines(complexity)))
+        print(complexity_table(complexity))
     print()
     log("wrote %s/{speed_error.csv,speed_error.png,complexity.csv,complexity.png,"
         "performance.md} in %.0f s" % (args.out, time.perf_counter() - start))

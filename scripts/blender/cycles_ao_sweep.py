@@ -104,10 +104,7 @@ def main():
     os.makedirs(os.path.dirname(prefix), exist_ok=True)
     scene = bpy.context.scene
     kit.build_scene(scene, args.scene, args.level)
-    while len(scene.view_layers) > 1:
-        scene.view_layers.remove(scene.view_layers[-1])
-    layer = scene.view_layers[0]
-    layer.name = reference.VIEW_LAYER_NAME
+    layer = reference.single_view_layer(scene)
     configure_fast_ao(scene, layer, args)
     triangles = kit.triangle_count(scene)
 

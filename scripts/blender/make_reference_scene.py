@@ -299,6 +299,15 @@ def use_multilayer_exr(img):
     return img
 
 
+def single_view_layer(scene):
+    """Removes every view layer but the first, names it ViewLayer and returns it."""
+    while len(scene.view_layers) > 1:
+        scene.view_layers.remove(scene.view_layers[-1])
+    layer = scene.view_layers[0]
+    layer.name = VIEW_LAYER_NAME
+    return layer
+
+
 def configure_render(scene, args, exr_path):
     r = scene.render
     r.resolution_x = args.width
@@ -338,10 +347,7 @@ def configure_render(scene, args, exr_path):
     r.filepath = exr_path
 
     # Exactly one view layer, named ViewLayer, with the passes we need.
-    while len(scene.view_layers) > 1:
-        scene.view_layers.remove(scene.view_layers[-1])
-    layer = scene.view_layers[0]
-    layer.name = VIEW_LAYER_NAME
+    layer = single_view_layer(scene)
     layer.use = True
     layer.use_pass_combined = True
     layer.use_pass_z = True
