@@ -17,14 +17,16 @@ from . import pipeline, ssao_native
 
 # Library parameters the node exposes, by their library names (the rest are set by the add-on:
 # camera, conventions, threads).
-NODE_PARAMETERS = ("variant", "radius", "samples", "steps", "bias", "thickness",
-                   "sample_clustering", "sphere_mode", "denoise", "strength", "power",
-                   "remap_min", "remap_max", "seed")
+NODE_PARAMETERS = ("variant", "radius", "quality", "samples", "slices", "steps", "bias",
+                   "thickness", "sample_clustering", "sphere_mode", "denoise", "strength",
+                   "power", "remap_min", "remap_max", "seed")
 
 EXPORT_NODE, AO_NODE, MULTIPLY_NODE = "SSAO Export", "SSAO AO", "SSAO Multiply"
 
 # Why the library's parameter table could not be read (shown on the node), or None.
 LIBRARY_ERROR = None
+# Variant name -> the parameters only it reads (the node hides them for other variants).
+VARIANT_PARAMETERS = {}
 
 
 def _on_parameter_changed(node, context):
@@ -56,6 +58,8 @@ def _parameter_table():
     global LIBRARY_ERROR
     try:
         table = {p["name"]: p for p in ssao_native.parameters(pipeline.library())}
+        VARIANT_PARAMETERS.update({v["name"]: set(v["parameters"])
+                                   for v in ssao_native.variants(pipeline.library())})
     except Exception as error:  # the node must still register so .blend files open
         LIBRARY_ERROR = str(error)
         return {}
@@ -102,8 +106,10 @@ class CompositorNodeSSAO(bpy.types.CompositorNodeCustomGroup):
     def draw_buttons(self, context, layout):
         if LIBRARY_ERROR:
             layout.label(text="libssao missing (see console)", icon='ERROR')
+        variant_specific = set().union(*VARIANT_PARAMETERS.values())
+        active = VARIANT_PARAMETERS.get(getattr(self, "variant", ""), variant_specific)
         for name in self.bl_rna.properties.keys():
-            if name in NODE_PARAMETERS:
+            if name in NODE_PARAMETERS and (name not in variant_specific or name in active):
                 layout.prop(self, name)
         layout.operator("ssao.recompute", icon='FILE_REFRESH')
         if self.status:

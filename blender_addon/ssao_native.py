@@ -33,6 +33,14 @@ class _ParamDesc(ctypes.Structure):
     ]
 
 
+class _VariantDesc(ctypes.Structure):
+    _fields_ = [
+        ("name", ctypes.c_char_p),
+        ("description", ctypes.c_char_p),
+        ("parameters", ctypes.c_char_p),
+    ]
+
+
 PARAM_INT, PARAM_FLOAT, PARAM_STRING, PARAM_FLOATS = 0, 1, 2, 3
 _PROGRESS_FN = ctypes.CFUNCTYPE(ctypes.c_int, ctypes.c_void_p, ctypes.c_double)
 
@@ -82,6 +90,9 @@ def _declare(lib):
     sig("ssao_last_error", cstr, checked=False)
     sig("ssao_param_count", ctypes.c_size_t, checked=False)
     sig("ssao_param_info", c_int, ctypes.c_size_t, ctypes.POINTER(_ParamDesc))
+    if hasattr(lib, "ssao_variant_count"):  # since 0.1 after 45f8526
+        sig("ssao_variant_count", ctypes.c_size_t, checked=False)
+        sig("ssao_variant_info", c_int, ctypes.c_size_t, ctypes.POINTER(_VariantDesc))
     sig("ssao_job_create", c_int, ctypes.POINTER(ctypes.c_void_p))
     sig("ssao_job_destroy", None, job, checked=False)
     sig("ssao_job_set_int", c_int, job, cstr, c_int)
@@ -110,6 +121,20 @@ def parameters(lib):
             "choices": text(d.choices).split("|") if d.choices else None, "count": d.count,
             "unit": text(d.unit), "description": text(d.description),
         })
+    return out
+
+
+def variants(lib):
+    """Returns the library's variants as a list of dicts (name, description, parameters: the
+    names of the parameters only that variant reads)."""
+    out = []
+    if not hasattr(lib, "ssao_variant_count"):
+        return out
+    for i in range(lib.ssao_variant_count()):
+        d = _VariantDesc()
+        lib.ssao_variant_info(i, ctypes.byref(d))
+        out.append({"name": d.name.decode(), "description": d.description.decode(),
+                    "parameters": d.parameters.decode().split("|")})
     return out
 
 

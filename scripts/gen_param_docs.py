@@ -21,6 +21,9 @@ Generated from the library's parameter table (`ssao_param_info()`) by
 parameter is set by name through the C API (`ssao_job_set_int/float/string/floats`), on the
 command line as `--name-with-dashes VALUE`, and (later) as a property of the Blender node.
 
+"""
+
+PARAMS_HEADER = """
 | name | type | default | range / choices | unit | description |
 |---|---|---|---|---|---|
 """
@@ -35,6 +38,19 @@ def number(value):
     return f"{value:g}"
 
 
+def render_variants(lib):
+    """The variants (ssao_variant_info) and the parameters only each of them reads."""
+    variants = ssao_native.variants(lib)
+    lines = ["## Variants", "",
+             "The `variant` parameter's choices (`ssao_variant_info()`). A count left at 0 "
+             "(`samples`, `slices`, `steps`) takes the `quality` preset's value for the variant.",
+             "", "| variant | reads | description |", "|---|---|---|"]
+    for v in variants:
+        reads = ", ".join(f"`{name}`" for name in v["parameters"])
+        lines.append(f"| `{v['name']}` | {reads} | {v['description']} |")
+    return "\n".join(lines) + "\n\n## All parameters\n"
+
+
 def render(lib):
     rows = []
     for p in ssao_native.parameters(lib):
@@ -47,7 +63,7 @@ def render(lib):
             span = f"{number(p['min'])} .. {number(p['max'])}"
         rows.append(f"| `{p['name']}` | {TYPES[p['type']]} | {default} | {span} | {p['unit']} "
                     f"| {p['description']} |")
-    return HEADER + "\n".join(rows) + "\n"
+    return HEADER + render_variants(lib) + PARAMS_HEADER + "\n".join(rows) + "\n"
 
 
 def main():

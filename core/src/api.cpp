@@ -9,6 +9,7 @@
 #include "job.h"
 #include "params.h"
 #include "ssao/ssao.h"
+#include "variants/variant.h"
 
 namespace {
 
@@ -72,6 +73,20 @@ SSAO_API ssao_status ssao_param_info(size_t index, ssao_param_desc* out) {
   return guarded([&] {
     if (out == nullptr) ssao::throw_invalid_argument("output pointer is NULL");
     *out = ssao::param_desc(index);
+  });
+}
+
+SSAO_API size_t ssao_variant_count(void) { return ssao::variant_registry().size(); }
+
+SSAO_API ssao_status ssao_variant_info(size_t index, ssao_variant_desc* out) {
+  return guarded([&] {
+    if (out == nullptr) ssao::throw_invalid_argument("output pointer is NULL");
+    const auto& variants = ssao::variant_registry();
+    if (index >= variants.size()) {
+      ssao::throw_invalid_argument("variant index " + std::to_string(index) + " out of range (" +
+                                   std::to_string(variants.size()) + " variants)");
+    }
+    *out = {variants[index].name, variants[index].description, variants[index].parameters};
   });
 }
 

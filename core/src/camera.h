@@ -60,6 +60,9 @@ class CameraModel {
     return orthographic_ ? Vec3{0.0f, 0.0f, 1.0f} : normalize_or(-p, Vec3{0.0f, 0.0f, 1.0f});
   }
 
+  // Height over width of one pixel in view space (1 unless the pixel aspect is not square).
+  float pixel_aspect() const { return scale_v_ / scale_u_; }
+
   // Width in view units of one pixel at planar depth d.
   float pixel_footprint(float planar_depth) const {
     return orthographic_ ? scale_u_ : scale_u_ * planar_depth;

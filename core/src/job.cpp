@@ -9,9 +9,8 @@
 #include "camera.h"
 #include "denoise.h"
 #include "error.h"
-#include "gbuffer.h"
-#include "kernels.h"
-#include "variants.h"
+#include "frame.h"
+#include "variants/variant.h"
 
 namespace ssao {
 namespace {
@@ -129,6 +128,13 @@ void Job::validate_images() const {
   }
 }
 
+TilePool& Job::pool(int threads) {
+  if (!pool_ || pool_->threads() != resolve_thread_count(threads)) {
+    pool_ = std::make_unique<TilePool>(threads);
+  }
+  return *pool_;
+}
+
 void Job::run() {
   validate_images();
   const int width = depth_.width, height = depth_.height;
@@ -136,10 +142,10 @@ void Job::run() {
 
   const ParamValues& v = params_;
   const CameraModel camera(camera_params(v), width, height);
-  const int threads = resolve_thread_count(v.get_int("threads"));
+  TilePool& tiles = pool(v.get_int("threads"));
   Progress progress(progress_callback_, progress_user_);
 
-  GBufferInputs in;
+  FrameInputs in;
   in.depth = depth_;
   in.normal = normal_;
   in.radial_depth = v.get_string("depth_kind") == "radial";
@@ -151,60 +157,50 @@ void Job::run() {
   in.clip_end = static_cast<float>(
       std::min(v.get_float("clip_end"), double(std::numeric_limits<float>::max())));
 
-  progress.set_stage(0.0, 0.1);
-  GBuffer gbuffer(camera, width, height);
-  gbuffer.build(in, threads, progress);
+  progress.set_stage(0.0, 0.05);
+  Frame frame(camera, width, height);
+  frame.build(in, tiles, progress);
 
-  VariantSettings settings;
-  settings.radius = static_cast<float>(v.get_float("radius"));
-  settings.bias = static_cast<float>(v.get_float("bias"));
-  settings.clustering = static_cast<float>(v.get_float("sample_clustering"));
-  settings.steps = v.get_int("steps");
-  settings.thickness = static_cast<float>(v.get_float("thickness"));
-  settings.seed = static_cast<uint32_t>(v.get_int("seed"));
-  settings.sphere_normalized = v.get_string("sphere_mode") == "normalized";
-  const bool sphere = v.get_string("variant") == "sphere";
-  const int samples = v.get_int("samples");
-  const Kernel kernel = sphere ? make_sphere_kernel(samples) : make_hemisphere_kernel(samples);
-
-  const VisibilityEstimator estimate = sphere ? sphere_visibility : hemisphere_visibility;
-
-  progress.set_stage(0.1, 0.9);
+  const std::unique_ptr<Variant> variant = find_variant(v.get_string("variant")).create(v, frame);
+  progress.set_stage(0.05, 0.95);
   std::vector<float> visibility(size_t(width) * size_t(height), 1.0f);
-  parallel_rows(height, threads, progress, [&](int y) {
-    float* row = visibility.data() + size_t(y) * width;
-    for (int x = 0; x < width; ++x) {
-      if (is_receiver(gbuffer, x, y, settings.radius)) {
-        row[x] = estimate(gbuffer, kernel, settings, x, y);
-      }
-    }
+  tiles.for_each_tile(width, height, progress, [&](const Tile& t) {
+    // A tile of background costs one pass over its depths.
+    if (frame.geometry_count(t.x0, t.y0, t.x1, t.y1) == 0) return;
+    variant->estimate(frame, t, visibility.data());
   });
 
-  progress.set_stage(0.9, 1.0);
-  visibility = denoise(gbuffer, visibility, denoise_mode(v.get_string("denoise")), settings.radius,
-                       threads, progress);
+  const float radius = static_cast<float>(v.get_float("radius"));
+  const Denoiser denoiser(frame, denoise_mode(v.get_string("denoise")), radius);
+  progress.set_stage(0.95, 1.0);
+  denoiser.horizontal_pass(visibility.data(), tiles, progress);
 
-  // Outputs are written only now, after every stage succeeded: a failed or cancelled run leaves
-  // the caller's buffers untouched.
+  // Outputs are written only now, after every cancellable stage succeeded: a failed or
+  // cancelled run leaves the caller's buffers untouched. This last stage cannot be cancelled.
   const Shaping shaping{
       static_cast<float>(v.get_float("power")), static_cast<float>(v.get_float("strength")),
       static_cast<float>(v.get_float("remap_min")), static_cast<float>(v.get_float("remap_max"))};
-  for (int y = 0; y < height; ++y) {
-    for (int x = 0; x < width; ++x) {
-      const size_t i = size_t(y) * width + x;
-      const float ao = gbuffer.is_geometry(x, y) ? shaping.apply(visibility[i]) : 1.0f;
-      if (ao_out_.attached()) {
-        float* out = ao_out_.pixel(x, y);
-        for (int c = 0; c < std::min(ao_out_.channels, 3); ++c) out[c] = ao;
-        if (ao_out_.channels == 4) out[3] = 1.0f;
-      }
-      if (composite_out_.attached()) {
-        const float* src = beauty_.pixel(x, y);
-        float* dst = composite_out_.pixel(x, y);
-        for (int c = 0; c < composite_out_.channels; ++c) dst[c] = c < 3 ? src[c] * ao : src[c];
+  Progress uncancellable(nullptr, nullptr);
+  tiles.for_each_tile(width, height, uncancellable, [&](const Tile& t) {
+    for (int y = t.y0; y < t.y1; ++y) {
+      for (int x = t.x0; x < t.x1; ++x) {
+        const float ao = frame.is_geometry(x, y)
+                             ? shaping.apply(denoiser.vertical(visibility.data(), x, y))
+                             : 1.0f;
+        if (ao_out_.attached()) {
+          float* out = ao_out_.pixel(x, y);
+          for (int c = 0; c < std::min(ao_out_.channels, 3); ++c) out[c] = ao;
+          if (ao_out_.channels == 4) out[3] = 1.0f;
+        }
+        if (composite_out_.attached()) {
+          const float* src = beauty_.pixel(x, y);
+          float* dst = composite_out_.pixel(x, y);
+          for (int c = 0; c < composite_out_.channels; ++c) dst[c] = c < 3 ? src[c] * ao : src[c];
+        }
       }
     }
-  }
+  });
+  progress.report(1.0);
 }
 
 }  // namespace ssao

@@ -1,13 +1,14 @@
 // SPDX-License-Identifier: MIT
 // One AO job: parameter values, attached images, and the run pipeline
-// (geometry -> variant -> denoise -> shaping -> outputs).
+// (frame -> variant -> denoise -> shaping -> outputs), each stage on tiles.
 #pragma once
 
+#include <memory>
 #include <string>
 
 #include "image_view.h"
-#include "parallel.h"
 #include "params.h"
+#include "tiles.h"
 
 namespace ssao {
 
@@ -27,7 +28,10 @@ class Job {
  private:
   void validate_images() const;
 
+  TilePool& pool(int threads);
+
   ParamValues params_;
+  std::unique_ptr<TilePool> pool_;  // kept between runs: its threads are started once
   ImageView depth_, normal_, beauty_, ao_out_, composite_out_;
   Progress::Callback progress_callback_ = nullptr;
   void* progress_user_ = nullptr;

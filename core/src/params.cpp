@@ -31,27 +31,34 @@ ssao_param_desc string_param(const char* name, const char* def, const char* choi
 const std::vector<ssao_param_desc>& table() {
   static const std::vector<ssao_param_desc> params = {
       // --- algorithm ---
-      string_param("variant", "hemisphere", "hemisphere|sphere",
-                   "hemisphere: normal-oriented hemisphere kernel; sphere: Crysis sphere kernel "
-                   "(depth only)"),
+      string_param("variant", "hemisphere", "horizon|hemisphere|sphere",
+                   "horizon: horizon-based slices with a visibility bitmask (GTAO); hemisphere: "
+                   "normal-oriented hemisphere kernel; sphere: Crysis sphere kernel (depth only)"),
       float_param("radius", 1.0, 1e-6, 1e9, "scene units",
                   "distance within which geometry occludes, as Cycles' AO distance"),
-      int_param("samples", 16, 1, 1024, "directions per pixel",
-                "kernel directions per pixel (sphere: points per pixel)"),
-      int_param("steps", 6, 1, 64, "samples per direction",
-                "hemisphere: samples along each direction, the strongest occluder counts; 1 is "
-                "the classic kernel of independent points"),
+      string_param("quality", "medium", "low|medium|high|ultra",
+                   "sample counts of the variant (samples, slices, steps) that are left at 0"),
+      int_param("samples", 0, 0, 1024, "directions per pixel",
+                "hemisphere: kernel directions per pixel; sphere: points per pixel; 0: from "
+                "quality"),
+      int_param("slices", 0, 0, 64, "slices per pixel",
+                "horizon: screen-space lines through each pixel; 0: from quality"),
+      int_param("steps", 0, 0, 64, "samples per direction",
+                "hemisphere: samples along each direction, the strongest occluder counts (1 is "
+                "the classic kernel of independent points); horizon: samples on each side of a "
+                "slice; 0: from quality"),
       float_param("bias", 0.02, 0.0, 1.0, "fraction of radius",
-                  "height above the receiver's tangent plane (hemisphere) or behind the sample "
-                  "(sphere) an occluder needs to count; one pixel footprint is added"),
+                  "height above the receiver's tangent plane (hemisphere, horizon) or behind the "
+                  "sample (sphere) an occluder needs to count; one pixel footprint is added"),
       float_param("sample_clustering", 1.0, 0.0, 4.0, "exponent",
                   "samples sit at radius * lerp(0.1, 1, s^p) for s uniform in [0,1): 0 puts all "
                   "on the kernel's surface, 2 clusters them toward the centre as the seed code "
                   "does"),
       float_param(
           "thickness", 0.5, 0.01, 100.0, "fraction of radius",
-          "hemisphere: assumed thickness of surfaces: a sample this far behind the visible surface "
-          "counts fully, fading out at twice the distance (range check against halos)"),
+          "assumed thickness of surfaces: horizon: an occluder spans this far behind the visible "
+          "surface; hemisphere: a sample this far behind the visible surface counts fully, "
+          "fading out at twice the distance (range check against halos)"),
       string_param("sphere_mode", "normalized", "normalized|classic",
                    "sphere variant: classic reads about 0.5 on a flat wall; normalized maps an "
                    "unoccluded flat surface to 1"),

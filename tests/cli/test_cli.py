@@ -336,7 +336,7 @@ class HelpTest(CliTestCase):
             self.assertIn("--" + name.replace("_", "-") + " ", proc.stdout, name)
         for flag in ["-o", "--camera", "--ao-only", "--layer", "--depth-channel",
                      "--normal-channels", "--beauty-channels", "--no-normals", "--quiet",
-                     "--version", "hemisphere|sphere", "default 16"]:
+                     "--version", "horizon|hemisphere|sphere", "low|medium|high|ultra"]:
             self.assertIn(flag, proc.stdout)
 
     def test_version(self):
@@ -442,7 +442,7 @@ class BadInputTest(CliTestCase):
             (["--radius", "nan"], "--radius", "finite"),
             (["--radius", "inf"], "--radius", "finite"),
             (["--radius", "-1"], "--radius", "radius"),   # the core's range check
-            (["--samples", "0"], "--samples", "samples"),  # the core's range check
+            (["--samples", "-1"], "--samples", "samples"),  # the core's range check
             (["--variant", "foo"], "--variant", "hemisphere"),
             (["--radius"], "--radius", "requires a value"),
             (["--normal-channels", "X,Y"], "--normal-channels", "3"),

@@ -86,6 +86,15 @@ typedef struct ssao_param_desc {
   const char* description;    /* one sentence */
 } ssao_param_desc;
 
+/* Describes one AO variant (the "variant" parameter's choices). Strings are static. */
+typedef struct ssao_variant_desc {
+  const char* name;        /* the value of the "variant" parameter, e.g. "horizon" */
+  const char* description; /* one sentence */
+  /* The parameters this variant reads, '|'-separated, beyond those every variant reads (the
+     ones no variant lists). A front end shows these only while the variant is selected. */
+  const char* parameters;
+} ssao_variant_desc;
+
 /* Called with the fraction done in [0, 1], non-decreasing. Return 0 to cancel the run. */
 typedef int (*ssao_progress_fn)(void* user, double fraction);
 
@@ -103,6 +112,11 @@ SSAO_API const char* ssao_last_error(void);
 SSAO_API size_t ssao_param_count(void);
 /* Describes parameter number "index" (0 <= index < ssao_param_count()). */
 SSAO_API ssao_status ssao_param_info(size_t index, ssao_param_desc* out);
+
+/* Returns the number of variants; index them with ssao_variant_info(). */
+SSAO_API size_t ssao_variant_count(void);
+/* Describes variant number "index" (0 <= index < ssao_variant_count()). */
+SSAO_API ssao_status ssao_variant_info(size_t index, ssao_variant_desc* out);
 
 /* Creates a job with every parameter at its default and no images attached. */
 SSAO_API ssao_status ssao_job_create(ssao_job* out);

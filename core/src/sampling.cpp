@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: MIT
-#include "kernels.h"
+#include "sampling.h"
 
 #include <cmath>
 #include <numeric>
@@ -68,19 +68,20 @@ float radial_scale(float s, float clustering) {
   return 0.1f + 0.9f * shaped;
 }
 
-PixelJitter pixel_jitter(int x, int y, uint32_t seed) {
-  // 4x4 ordered-dither (Bayer) indices: neighbours get rotations far apart.
-  static const int bayer[4][4] = {{0, 8, 2, 10}, {12, 4, 14, 6}, {3, 11, 1, 9}, {15, 7, 13, 5}};
-  const int index = bayer[y & 3][x & 3];
+std::array<JitterState, kJitterStates> jitter_states(uint32_t seed) {
   const uint32_t h = hash_u32(seed * 0x9e3779b9U + 0x632be5abU);
   const float angle_offset = unit_float(h);
   const float radial_seed = unit_float(hash_u32(h));
-  const float angle = 2.0f * kPi * (float(index) + angle_offset) / 16.0f;
-  // A second, differently ordered index for the radius: 7 is coprime with 16.
-  const int radial_index = (index * 7 + 3) & 15;
-  float radial = (float(radial_index) + radial_seed) / 16.0f;
-  if (radial >= 1.0f) radial -= 1.0f;
-  return {std::cos(angle), std::sin(angle), radial};
+  std::array<JitterState, kJitterStates> states{};
+  for (int index = 0; index < kJitterStates; ++index) {
+    const float angle = (float(index) + angle_offset) / float(kJitterStates);
+    // A second, differently ordered index for the radius: 7 is coprime with 16.
+    const int radial_index = (index * 7 + 3) & 15;
+    float radial = (float(radial_index) + radial_seed) / float(kJitterStates);
+    if (radial >= 1.0f) radial -= 1.0f;
+    states[index] = {angle, std::cos(2.0f * kPi * angle), std::sin(2.0f * kPi * angle), radial};
+  }
+  return states;
 }
 
 }  // namespace ssao

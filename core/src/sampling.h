@@ -1,7 +1,9 @@
 // SPDX-License-Identifier: MIT
-// Sample kernels and the per-pixel kernel rotation pattern shared by the variants.
+// Sampling patterns shared by the variants: point kernels and the per-pixel jitter pattern. All
+// of it is computed once per run into tables; nothing here runs per sample.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <vector>
 
@@ -29,14 +31,22 @@ Kernel make_sphere_kernel(int samples);
 // lerp(0.1, 1, s^clustering). Clustering 2 is the seed code's curve; 0 puts all samples at 1.
 float radial_scale(float s, float clustering);
 
-// Per-pixel rotation and radial offset from a 4x4 tile: the 16 pixels of a tile see 16 distinct
-// rotations (an ordered-dither pattern), so a 4-pixel-periodic blur averages them all.
-struct PixelJitter {
-  float cos_angle, sin_angle;  // rotation about the kernel's axis
+// Per-pixel rotation and offset from a 4x4 tile: the 16 pixels of a tile see 16 distinct states
+// (an ordered-dither pattern), so a 4-pixel-periodic blur averages them all.
+constexpr int kNoiseTileSize = 4;
+constexpr int kJitterStates = kNoiseTileSize * kNoiseTileSize;
+inline int jitter_index(int x, int y) {
+  // 4x4 ordered-dither (Bayer) indices: neighbours get states far apart.
+  static constexpr int bayer[4][4] = {{0, 8, 2, 10}, {12, 4, 14, 6}, {3, 11, 1, 9}, {15, 7, 13, 5}};
+  return bayer[y & 3][x & 3];
+}
+
+struct JitterState {
+  float angle;                 // in [0, 1): a fraction of the full turn (or of the slice range)
+  float cos_angle, sin_angle;  // of 2 * pi * angle
   float radial_offset;         // in [0, 1): sub-stratum position of the radial samples
 };
-PixelJitter pixel_jitter(int x, int y, uint32_t seed);
-
-constexpr int kNoiseTileSize = 4;
+// The 16 states for a seed, indexed by jitter_index().
+std::array<JitterState, kJitterStates> jitter_states(uint32_t seed);
 
 }  // namespace ssao

@@ -1,0 +1,136 @@
+#!/usr/bin/python3
+# SPDX-License-Identifier: MIT
+"""Times two builds of libssao on the same frame in one process: before/after figures for a
+change to a hot path.
+
+    /usr/bin/python3 benchmarks/compare_libraries.py --baseline OLD/libssao.so \\
+        [--candidate build/lib/libssao.so] SCENE.exr --camera CAM.json --radius R \\
+        [--threads 2] [--repeat 7] [--set NAME=VALUE ...] [--baseline-set NAME=VALUE ...]
+
+Reads Depth and Normal from a Blender multilayer EXR (as ssao_eval does), runs the baseline and
+the candidate in interleaved rounds (B C B C ...) after one untimed round each, and prints the
+median and fastest time of each, their ratio, and the largest AO difference between the two.
+--set applies to both libraries, --baseline-set / --candidate-set to one.
+"""
+import argparse
+import json
+import os
+import statistics
+import sys
+import time
+
+import numpy as np
+import OpenImageIO as oiio
+
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "blender_addon"))
+import ssao_native  # noqa: E402
+
+
+def read_passes(path):
+    image = oiio.ImageInput.open(path)
+    if image is None:
+        sys.exit(f"compare_libraries: cannot open {path}: {oiio.geterror()}")
+    names = list(image.spec().channelnames)
+    pixels = image.read_image(format="float")
+    image.close()
+
+    def find(suffixes):
+        for suffix in suffixes:
+            for i, name in enumerate(names):
+                if name.endswith(suffix):
+                    return i
+        sys.exit(f"compare_libraries: {path} has no channel ending in {suffixes[0]}")
+    depth = np.ascontiguousarray(pixels[:, :, find(["Depth.Z", "Depth.V"])])
+    normal = np.ascontiguousarray(pixels[:, :, [find(["Normal.X"]), find(["Normal.Y"]),
+                                                find(["Normal.Z"])]])
+    return depth, normal
+
+
+def camera_parameters(path):
+    with open(path) as f:
+        cam = json.load(f)
+    params = {"camera_type": cam["type"], "camera_to_world": [v for row in cam["matrix_world"]
+                                                              for v in row]}
+    for name in ("lens", "sensor_width", "sensor_height", "sensor_fit", "shift_x", "shift_y",
+                 "ortho_scale", "clip_end"):
+        params[name] = cam[name]
+    return params
+
+
+def parse_sets(items):
+    out = {}
+    for item in items:
+        name, _, value = item.partition("=")
+        out[name] = value
+    return out
+
+
+class Runner:
+    def __init__(self, path, params, depth, normal):
+        self.lib = ssao_native.load_library(path)
+        self.ao = np.zeros(depth.shape, np.float32)
+        self.job = ssao_native.Job(self.lib)
+        types = {p["name"]: p["type"] for p in ssao_native.parameters(self.lib)}
+        for name, value in params.items():
+            if types.get(name) == ssao_native.PARAM_INT:
+                value = int(value)
+            elif types.get(name) == ssao_native.PARAM_FLOAT:
+                value = float(value)
+            self.job.set(name, value)
+        self.job.set_image("depth", depth)
+        self.job.set_image("normal", normal)
+        self.job.set_image("ao", self.ao)
+        self.times = []
+
+    def run(self, timed=True):
+        start = time.perf_counter()
+        self.job.run()
+        if timed:
+            self.times.append(time.perf_counter() - start)
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("scene")
+    parser.add_argument("--baseline", required=True, help="the libssao.so to compare against")
+    parser.add_argument("--candidate", default=None, help="default: build/lib/libssao.so")
+    parser.add_argument("--camera", required=True)
+    parser.add_argument("--radius", type=float, required=True)
+    parser.add_argument("--threads", type=int, default=2)
+    parser.add_argument("--repeat", type=int, default=7)
+    parser.add_argument("--set", action="append", default=[])
+    parser.add_argument("--baseline-set", action="append", default=[])
+    parser.add_argument("--candidate-set", action="append", default=[])
+    args = parser.parse_args()
+    if args.repeat < 1:
+        parser.error("--repeat must be at least 1")
+
+    depth, normal = read_passes(args.scene)
+    common = camera_parameters(args.camera)
+    common.update(radius=args.radius, threads=args.threads)
+    common.update(parse_sets(args.set))
+    candidate = args.candidate or os.path.join(os.path.dirname(os.path.abspath(__file__)), "..",
+                                               "build", "lib", "libssao.so")
+    runners = {"baseline": Runner(args.baseline, {**common, **parse_sets(args.baseline_set)},
+                                  depth, normal),
+               "candidate": Runner(candidate, {**common, **parse_sets(args.candidate_set)},
+                                   depth, normal)}
+    for r in runners.values():
+        r.run(timed=False)
+    for _ in range(args.repeat):
+        for r in runners.values():
+            r.run()
+    height, width = depth.shape
+    print(f"frame {width}x{height}, threads {args.threads}, {args.repeat} interleaved rounds")
+    for name, r in runners.items():
+        print(f"{name:9s} median {1e3 * statistics.median(r.times):9.2f} ms  "
+              f"min {1e3 * min(r.times):9.2f} ms")
+    b, c = (statistics.median(runners[k].times) for k in ("baseline", "candidate"))
+    diff = float(np.abs(runners["baseline"].ao - runners["candidate"].ao).max())
+    print(f"speed-up {b / c:.2f}x (median baseline / median candidate); "
+          f"max |AO difference| {diff:.4g}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

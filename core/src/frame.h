@@ -1,0 +1,81 @@
+// SPDX-License-Identifier: MIT
+// The frame the variants read: one plane of planar depth (+inf = background) and one plane of
+// packed unit normals, prepared once per run from the caller's depth (and normal) images.
+// Positions are reconstructed from depth on the fly: two multiplies are cheaper than the memory
+// traffic of a stored position, and the two planes are 8 bytes a pixel.
+#pragma once
+
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <vector>
+
+#include "camera.h"
+#include "image_view.h"
+#include "tiles.h"
+#include "vec3.h"
+
+namespace ssao {
+
+struct FrameInputs {
+  ImageView depth;
+  ImageView normal;  // optional (data == nullptr: reconstruct from depth)
+  bool radial_depth = false;
+  bool world_normals = true;
+  double camera_to_world[16] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
+  float background_depth = 1e9f;  // depth >= this (or >= clip_end when > 0) is background
+  float clip_end = 0.0f;
+};
+
+// Unit vector <-> 32 bits: octahedral mapping with 16 bits per coordinate (error < 1e-4 rad).
+uint32_t encode_normal(Vec3 n);
+inline Vec3 decode_normal(uint32_t bits) {
+  const float u = float(int16_t(bits & 0xffffu)) * (1.0f / 32767.0f);
+  const float v = float(int16_t(bits >> 16)) * (1.0f / 32767.0f);
+  Vec3 n{u, v, 1.0f - std::fabs(u) - std::fabs(v)};
+  if (n.z < 0.0f) {  // the lower half is folded over the diagonals
+    const float fu = (1.0f - std::fabs(v)) * std::copysign(1.0f, u);
+    const float fv = (1.0f - std::fabs(u)) * std::copysign(1.0f, v);
+    n.x = fu;
+    n.y = fv;
+  }
+  return n * (1.0f / length(n));
+}
+
+class Frame {
+ public:
+  static constexpr float kBackground = std::numeric_limits<float>::infinity();
+
+  Frame(const CameraModel& camera, int width, int height);
+
+  // Fills the depth plane, then the normals (from the normal image or reconstructed from depth).
+  void build(const FrameInputs& in, TilePool& pool, Progress& progress);
+
+  int width() const { return width_; }
+  int height() const { return height_; }
+  const CameraModel& camera() const { return camera_; }
+  size_t index(int x, int y) const { return size_t(y) * size_t(width_) + size_t(x); }
+
+  // Planar depth plane, row-major; kBackground where there is no geometry.
+  const float* depth_plane() const { return depth_.data(); }
+  float depth(int x, int y) const { return depth_[index(x, y)]; }
+  bool is_geometry(int x, int y) const { return depth_[index(x, y)] != kBackground; }
+  Vec3 position(int x, int y) const {
+    return camera_.view_position(float(x) + 0.5f, float(y) + 0.5f, depth(x, y));
+  }
+  Vec3 normal(int x, int y) const { return decode_normal(normal_[index(x, y)]); }
+  const uint32_t* normal_plane() const { return normal_.data(); }
+
+  // Pixels of geometry in rows [y0, y1) x columns [x0, x1).
+  size_t geometry_count(int x0, int y0, int x1, int y1) const;
+
+ private:
+  Vec3 reconstructed_normal(int x, int y) const;
+
+  CameraModel camera_;
+  int width_, height_;
+  std::vector<float> depth_;
+  std::vector<uint32_t> normal_;
+};
+
+}  // namespace ssao

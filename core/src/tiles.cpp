@@ -1,0 +1,91 @@
+// SPDX-License-Identifier: MIT
+#include "tiles.h"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
+
+#include <algorithm>
+#include <atomic>
+#include <thread>
+
+#include "error.h"
+
+namespace ssao {
+
+bool Progress::report(double stage_fraction) {
+  if (cancelled_) return false;
+  const double fraction = std::clamp(begin_ + (end_ - begin_) * stage_fraction, 0.0, 1.0);
+  if (fraction < last_) return true;  // keep the reported values non-decreasing
+  last_ = fraction;
+  if (callback_ != nullptr && callback_(user_, fraction) == 0) cancelled_ = true;
+  return !cancelled_;
+}
+
+void Progress::throw_if_cancelled() const {
+  if (cancelled_) throw Error(SSAO_ERROR_CANCELLED, "cancelled by the progress callback");
+}
+
+int resolve_thread_count(int requested) {
+  if (requested > 0) return requested;
+  const unsigned hw = std::thread::hardware_concurrency();
+  return hw == 0 ? 1 : static_cast<int>(hw);
+}
+
+struct TilePool::Arena {
+  explicit Arena(int threads) : arena(threads) {}
+  tbb::task_arena arena;
+};
+
+TilePool::TilePool(int threads)
+    : threads_(resolve_thread_count(threads)), arena_(std::make_unique<Arena>(threads_)) {}
+
+TilePool::~TilePool() = default;
+
+void TilePool::for_each_tile(int width, int height, Progress& progress,
+                             const std::function<void(const Tile&)>& fn) {
+  run(width, height, kTileWidth, kTileHeight, progress, fn);
+}
+
+void TilePool::for_each_row_band(int width, int height, int rows, Progress& progress,
+                                 const std::function<void(const Tile&)>& fn) {
+  run(width, height, std::max(1, width), std::max(1, rows), progress, fn);
+}
+
+void TilePool::run(int width, int height, int tile_width, int tile_height, Progress& progress,
+                   const std::function<void(const Tile&)>& fn) {
+  if (width <= 0 || height <= 0) return;
+  progress.throw_if_cancelled();
+  const int columns = (width + tile_width - 1) / tile_width;
+  const int rows = (height + tile_height - 1) / tile_height;
+  const int count = columns * rows;
+  const std::thread::id caller = std::this_thread::get_id();
+  std::atomic<int> done{0};
+  std::atomic<bool> stop{false};
+
+  auto one_tile = [&](int index) {
+    if (stop.load(std::memory_order_relaxed)) return;
+    const int tx = index % columns, ty = index / columns;
+    const Tile tile{tx * tile_width, ty * tile_height, std::min(width, (tx + 1) * tile_width),
+                    std::min(height, (ty + 1) * tile_height)};
+    fn(tile);
+    const int finished = done.fetch_add(1) + 1;
+    // Only the caller's thread talks to the progress callback.
+    if (std::this_thread::get_id() == caller && !progress.report(double(finished) / count)) {
+      stop = true;
+    }
+  };
+  arena_->arena.execute([&] {
+    tbb::parallel_for(
+        tbb::blocked_range<int>(0, count, 1),
+        [&](const tbb::blocked_range<int>& r) {
+          for (int i = r.begin(); i != r.end(); ++i) one_tile(i);
+        },
+        tbb::simple_partitioner());
+  });
+  progress.throw_if_cancelled();
+  progress.report(1.0);
+  progress.throw_if_cancelled();
+}
+
+}  // namespace ssao
