@@ -45,21 +45,26 @@ NOISE_BORDER = (0.25, 0.75, 0.25, 0.75)
 
 # Library rows: (method, setting label, ssao_eval settings). "default" is the product's default.
 LIBRARY_FULL = [
-    ("hemisphere", "default", []),
-    ("hemisphere", "samples=4", ["samples=4"]),
-    ("hemisphere", "samples=8", ["samples=8"]),
-    ("hemisphere", "samples=8,steps=3", ["samples=8", "steps=3"]),
-    ("hemisphere", "samples=32", ["samples=32"]),
-    ("sphere", "samples=8", ["variant=sphere", "samples=8"]),
-    ("sphere", "samples=16", ["variant=sphere"]),
-    ("sphere", "samples=32", ["variant=sphere", "samples=32"]),
-    ("sphere", "samples=64", ["variant=sphere", "samples=64"]),
-    ("sphere", "classic,samples=16", ["variant=sphere", "sphere_mode=classic"]),
+    ("hemisphere", "default", []),  # quality=medium
+    ("hemisphere", "quality=low", ["quality=low"]),
+    ("hemisphere", "quality=high", ["quality=high"]),
+    ("hemisphere", "quality=ultra", ["quality=ultra"]),
+    # The default of 45f8526, before the presets: the accuracy the default must keep.
+    ("hemisphere", "samples=16,steps=6,clustering=1",
+     ["samples=16", "steps=6", "sample_clustering=1"]),
+    ("horizon", "quality=low", ["variant=horizon", "quality=low"]),
+    ("horizon", "quality=medium", ["variant=horizon"]),
+    ("horizon", "quality=high", ["variant=horizon", "quality=high"]),
+    ("horizon", "quality=ultra", ["variant=horizon", "quality=ultra"]),
+    ("sphere", "quality=low", ["variant=sphere", "quality=low"]),
+    ("sphere", "quality=medium", ["variant=sphere"]),
+    ("sphere", "quality=ultra", ["variant=sphere", "quality=ultra"]),
+    ("sphere", "classic,quality=medium", ["variant=sphere", "sphere_mode=classic"]),
 ]
 LIBRARY_QUICK = [
     ("hemisphere", "default", []),
-    ("hemisphere", "samples=8", ["samples=8"]),
-    ("sphere", "samples=16", ["variant=sphere"]),
+    ("horizon", "quality=medium", ["variant=horizon"]),
+    ("sphere", "quality=medium", ["variant=sphere"]),
 ]
 # The straight ports of the seed tutorials (tests/reference/seed_ports.cpp) and the brute-force
 # ray march (the accuracy floor of any depth-buffer method; only at 640x360, it is slow).
@@ -343,10 +348,11 @@ def series_name(row):
     """The curve a library row belongs to: its variant, plus any setting other than the sample
     count ("hemisphere", "hemisphere steps=3", "sphere classic"), so that a curve varies the
     samples only. Other methods are one curve each."""
-    if row["method"] not in ("hemisphere", "sphere"):
+    if row["method"] not in ("hemisphere", "sphere", "horizon"):
         return row["method"]
     extra = [part for part in row["setting"].split(",")
-             if part != "default" and not part.startswith("samples=")]
+             if part != "default" and not part.startswith(("samples=", "quality=", "steps="))
+             and not part.startswith("clustering=")]
     return " ".join([row["method"]] + extra)
 
 
@@ -357,6 +363,7 @@ def plot_speed_error(path, rows, truth):
     lines = (len(scenes) + columns - 1) // columns
     fig, axes = plt.subplots(lines, columns, figsize=(5.2 * columns, 4.0 * lines), squeeze=False)
     styles = {"hemisphere": ("C0", "o"), "sphere": ("C1", "s"), "cycles": ("C3", "^"),
+              "horizon": ("C5", "P"),
               "seed-hemisphere": ("C2", "D"), "seed-sphere": ("C4", "v"),
               "raymarch": ("C5", "P")}
     for ax, scene in zip(axes.flat, scenes):

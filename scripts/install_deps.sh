@@ -7,6 +7,7 @@ PACKAGES=(
   g++ cmake ninja-build pkg-config clang-format   # build, style check
   libgtest-dev                              # unit tests
   libtbb-dev                                # the library's thread pool (oneTBB)
+  libhwy-dev                                # the library's SIMD kernels (Highway)
   libopenimageio-dev openimageio-tools      # EXR I/O of the command-line tool
   libopenexr-dev nlohmann-json3-dev
   python3-numpy python3-openimageio         # Python test helpers (/usr/bin/python3)

@@ -21,12 +21,22 @@ struct CameraParams {
   double pixel_aspect_x = 1.0, pixel_aspect_y = 1.0;
 };
 
+// The pinhole (or orthographic) mapping as plain numbers, for vectorised kernels:
+//   view x = (u - center_u) * scale_u [* depth], view y = (center_v - v) * scale_v [* depth].
+struct CameraIntrinsics {
+  bool orthographic;
+  float scale_u, scale_v, center_u, center_v;
+};
+
 class CameraModel {
  public:
   // Mirrors Blender's viewplane computation (BKE_camera_params_compute_viewplane).
   CameraModel(const CameraParams& params, int width, int height);
 
   bool orthographic() const { return orthographic_; }
+  CameraIntrinsics intrinsics() const {
+    return {orthographic_, scale_u_, scale_v_, center_u_, center_v_};
+  }
 
   // View-space position of the point at planar depth d seen through continuous image
   // coordinates (u, v).

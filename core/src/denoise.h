@@ -1,8 +1,12 @@
 // SPDX-License-Identifier: MIT
 // Blurs that remove the 4x4 jitter pattern from the raw AO estimate. Both are separable: a
-// horizontal pass in place over row bands, then a vertical pass that the job fuses with the
-// output stage, so the filter needs no image-size buffer of its own.
+// horizontal pass in place over row bands, then a vertical pass per tile that the job fuses with
+// the output stage, so the filter needs no image-size buffer of its own. Each pass first decodes
+// the positions and normals it reads into planes of floats, so its inner loop is contiguous
+// loads that the compiler vectorises.
 #pragma once
+
+#include <vector>
 
 #include "frame.h"
 #include "tiles.h"
@@ -19,13 +23,11 @@ class Denoiser {
   // Filters the rows of `visibility` in place. Background pixels keep their value and are never
   // read.
   void horizontal_pass(float* visibility, TilePool& pool, Progress& progress) const;
-  // The vertical pass at one geometry pixel, reading the horizontally filtered visibility.
-  float vertical(const float* visibility, int x, int y) const;
+  // The vertical pass over one tile, reading the horizontally filtered visibility; writes
+  // out[(y - t.y0) * (t.x1 - t.x0) + (x - t.x0)].
+  void vertical_pass(const float* visibility, const Tile& t, float* out) const;
 
  private:
-  template <bool Horizontal>
-  float filter(const float* visibility, int x, int y) const;
-
   const Frame& f_;
   DenoiseMode mode_;
   float radius_;

@@ -3,6 +3,8 @@
 
 #include <cmath>
 
+#include "simd.h"
+
 namespace ssao {
 namespace {
 
@@ -12,38 +14,15 @@ bool is_background_depth(float d, const FrameInputs& in) {
   return in.clip_end > 0.0f && d >= in.clip_end;
 }
 
-// Normals transform with the transpose of the camera's rotation (inverse-transpose of the
-// world-to-camera map), so a scaled camera matrix is handled too; the result is renormalised.
-Vec3 world_to_view_normal(const double* m, Vec3 n) {
-  return {static_cast<float>(m[0] * n.x + m[4] * n.y + m[8] * n.z),
-          static_cast<float>(m[1] * n.x + m[5] * n.y + m[9] * n.z),
-          static_cast<float>(m[2] * n.x + m[6] * n.y + m[10] * n.z)};
-}
-
-int16_t snorm16(float v) {
-  return int16_t(std::lround(std::fmax(-1.0f, std::fmin(1.0f, v)) * 32767.0f));
-}
-
 }  // namespace
 
-uint32_t encode_normal(Vec3 n) {
-  const float l1 = std::fabs(n.x) + std::fabs(n.y) + std::fabs(n.z);
-  float u = n.x / l1, v = n.y / l1;
-  if (n.z < 0.0f) {
-    const float fu = (1.0f - std::fabs(v)) * std::copysign(1.0f, u);
-    const float fv = (1.0f - std::fabs(u)) * std::copysign(1.0f, v);
-    u = fu;
-    v = fv;
-  }
-  return uint32_t(uint16_t(snorm16(u))) | (uint32_t(uint16_t(snorm16(v))) << 16);
+void Frame::reset(const CameraModel& camera, int width, int height) {
+  camera_ = camera;
+  width_ = width;
+  height_ = height;
+  depth_.resize(size_t(width) * size_t(height));
+  normal_.resize(size_t(width) * size_t(height));
 }
-
-Frame::Frame(const CameraModel& camera, int width, int height)
-    : camera_(camera),
-      width_(width),
-      height_(height),
-      depth_(size_t(width) * size_t(height)),
-      normal_(size_t(width) * size_t(height)) {}
 
 size_t Frame::geometry_count(int x0, int y0, int x1, int y1) const {
   size_t count = 0;
@@ -67,31 +46,71 @@ void Frame::build(const FrameInputs& in, TilePool& pool, Progress& progress) {
   });
 
   // Normals need the neighbours' depths, so they come after every depth is known.
+  // View-space normals from world-space ones: the transpose of the camera's rotation (the
+  // inverse-transpose of world-to-camera, so a scaled camera matrix works too; renormalised).
+  const double* m = in.camera_to_world;
+  const float to_view[9] = {float(m[0]), float(m[4]), float(m[8]), float(m[1]), float(m[5]),
+                            float(m[9]), float(m[2]), float(m[6]), float(m[10])};
+  const float identity[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
+  const float* rotation = in.world_normals ? to_view : identity;
   pool.for_each_tile(width_, height_, progress, [&](const Tile& t) {
+    const int count = t.x1 - t.x0;
+    std::vector<float> nx(count, 0.0f), ny(count, 0.0f), nz(count, 0.0f);
+    std::vector<uint32_t> usable(count);
     for (int y = t.y0; y < t.y1; ++y) {
-      for (int x = t.x0; x < t.x1; ++x) {
-        const size_t i = index(x, y);
-        if (depth_[i] == kBackground) {
-          normal_[i] = encode_normal({0.0f, 0.0f, 1.0f});
-          continue;
+      if (in.normal.attached()) {
+        for (int i = 0; i < count; ++i) {
+          const float* p = in.normal.pixel(t.x0 + i, y);
+          nx[i] = p[0], ny[i] = p[1], nz[i] = p[2];
         }
-        const Vec3 towards_camera = camera_.towards_camera(position(x, y));
-        Vec3 n{0.0f, 0.0f, 0.0f};
-        if (in.normal.attached()) {
-          const float* p = in.normal.pixel(x, y);
-          n = {p[0], p[1], p[2]};
-          if (in.world_normals) n = world_to_view_normal(in.camera_to_world, n);
-        }
-        // A missing, zero or non-finite normal (Blender writes 0 on background and blends on
-        // silhouettes) falls back to the depth-reconstructed one.
-        n = normalize_or(n, Vec3{0.0f, 0.0f, 0.0f});
-        if (dot(n, n) == 0.0f) n = reconstructed_normal(x, y);
-        // Shading normals of back faces point away from the camera; AO is about the visible side.
-        if (dot(n, towards_camera) < 0.0f) n = -n;
-        normal_[i] = encode_normal(n);
+      }
+      const size_t row = index(t.x0, y);
+      encode_normal_row(rotation, float(y) + 0.5f, t.x0, count, nx.data(), ny.data(), nz.data(),
+                        usable.data(), normal_.data() + row);
+      // A missing, zero or non-finite normal (Blender writes 0 on background and blends on
+      // silhouettes) falls back to the depth-reconstructed one.
+      for (int i = 0; i < count; ++i) {
+        if (usable[i] || depth_[row + i] == kBackground) continue;
+        const int x = t.x0 + i;
+        Vec3 n = reconstructed_normal(x, y);
+        if (dot(n, camera_.towards_camera(position(x, y))) < 0.0f) n = -n;
+        normal_[row + i] = encode_normal(n);
       }
     }
   });
+}
+
+// Normals of one row: rotated to view space, normalised, turned towards the camera (shading
+// normals of back faces point away from it; AO is about the visible side) and packed. A loop
+// without calls or branches, which the compiler vectorises; usable[i] = 0 where the normal is
+// zero or not finite.
+SSAO_VECTORIZE void Frame::encode_normal_row(const float* rotation, float v, int x0, int count,
+                                             const float* __restrict nx, const float* __restrict ny,
+                                             const float* __restrict nz,
+                                             uint32_t* __restrict usable,
+                                             uint32_t* __restrict out) const {
+  const CameraIntrinsics cam = camera_.intrinsics();
+  const float r0 = rotation[0], r1 = rotation[1], r2 = rotation[2], r3 = rotation[3],
+              r4 = rotation[4], r5 = rotation[5], r6 = rotation[6], r7 = rotation[7],
+              r8 = rotation[8];
+  // The direction towards the camera, per unit of depth (branches on the camera type stay out of
+  // the loop, so it vectorises).
+  const float towards_x = cam.orthographic ? 0.0f : -cam.scale_u;
+  const float towards_y = cam.orthographic ? 0.0f : -(cam.center_v - v) * cam.scale_v;
+  for (int i = 0; i < count; ++i) {
+    float x = r0 * nx[i] + r1 * ny[i] + r2 * nz[i];
+    float y = r3 * nx[i] + r4 * ny[i] + r5 * nz[i];
+    float z = r6 * nx[i] + r7 * ny[i] + r8 * nz[i];
+    const float length2 = x * x + y * y + z * z;
+    const bool ok = length2 > 1e-40f && length2 <= 3.4e38f;  // false for NaN and infinity
+    const float inv = ok ? 1.0f / std::sqrt(ok ? length2 : 1.0f) : 0.0f;
+    x *= inv, y *= inv, z *= inv;
+    // Towards the camera is -position (perspective) or +z (orthographic).
+    const float facing = x * (float(x0 + i) + 0.5f - cam.center_u) * towards_x + y * towards_y + z;
+    const float flip = facing < 0.0f ? -1.0f : 1.0f;
+    usable[i] = ok ? 1 : 0;
+    out[i] = encode_normal({x * flip, y * flip, ok ? z * flip : 1.0f});
+  }
 }
 
 // Cross product of the screen-space tangents, each taken on the side whose depth is closer to

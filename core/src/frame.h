@@ -28,25 +28,41 @@ struct FrameInputs {
 };
 
 // Unit vector <-> 32 bits: octahedral mapping with 16 bits per coordinate (error < 1e-4 rad).
-uint32_t encode_normal(Vec3 n);
+// Both directions are branch-free (the lower half folded over the diagonals by a signed
+// offset), so loops over pixels vectorise.
+// v in [-1, 1] rounded to 16 bits (two's complement) in the low half of the result.
+inline uint32_t snorm16(float v) {
+  const float clamped = v < -1.0f ? -1.0f : (v > 1.0f ? 1.0f : v);
+  const float scaled = clamped * 32767.0f;
+  return uint32_t(int32_t(scaled + (scaled >= 0.0f ? 0.5f : -0.5f))) & 0xffffu;
+}
+inline uint32_t encode_normal(Vec3 n) {
+  const float l1 = std::fabs(n.x) + std::fabs(n.y) + std::fabs(n.z);
+  const float u = n.x / l1, v = n.y / l1;
+  // The lower half is folded over the diagonals: (1 - |v|, 1 - |u|) with the signs of (u, v).
+  const float fold_u = std::copysign(1.0f - std::fabs(v), u);
+  const float fold_v = std::copysign(1.0f - std::fabs(u), v);
+  const bool lower = n.z < 0.0f;
+  return snorm16(lower ? fold_u : u) | (snorm16(lower ? fold_v : v) << 16);
+}
 inline Vec3 decode_normal(uint32_t bits) {
-  const float u = float(int16_t(bits & 0xffffu)) * (1.0f / 32767.0f);
-  const float v = float(int16_t(bits >> 16)) * (1.0f / 32767.0f);
-  Vec3 n{u, v, 1.0f - std::fabs(u) - std::fabs(v)};
-  if (n.z < 0.0f) {  // the lower half is folded over the diagonals
-    const float fu = (1.0f - std::fabs(v)) * std::copysign(1.0f, u);
-    const float fv = (1.0f - std::fabs(u)) * std::copysign(1.0f, v);
-    n.x = fu;
-    n.y = fv;
-  }
-  return n * (1.0f / length(n));
+  // Sign-extended halves, in 32-bit arithmetic only (vectorises without AVX-512BW).
+  const float u = float(int32_t(bits << 16) >> 16) * (1.0f / 32767.0f);
+  const float v = float(int32_t(bits) >> 16) * (1.0f / 32767.0f);
+  const float z = 1.0f - std::fabs(u) - std::fabs(v);
+  const float fold = z < 0.0f ? -z : 0.0f;
+  const Vec3 n{u >= 0.0f ? u - fold : u + fold, v >= 0.0f ? v - fold : v + fold, z};
+  return n * (1.0f / std::sqrt(dot(n, n)));
 }
 
 class Frame {
  public:
   static constexpr float kBackground = std::numeric_limits<float>::infinity();
 
-  Frame(const CameraModel& camera, int width, int height);
+  Frame() = default;
+  // Sizes the planes for a frame (keeping their memory when the size is unchanged, so a job
+  // that runs frame after frame allocates once).
+  void reset(const CameraModel& camera, int width, int height);
 
   // Fills the depth plane, then the normals (from the normal image or reconstructed from depth).
   void build(const FrameInputs& in, TilePool& pool, Progress& progress);
@@ -71,9 +87,11 @@ class Frame {
 
  private:
   Vec3 reconstructed_normal(int x, int y) const;
+  void encode_normal_row(const float* rotation, float v, int x0, int count, const float* nx,
+                         const float* ny, const float* nz, uint32_t* usable, uint32_t* out) const;
 
-  CameraModel camera_;
-  int width_, height_;
+  CameraModel camera_{CameraParams{}, 1, 1};
+  int width_ = 0, height_ = 0;
   std::vector<float> depth_;
   std::vector<uint32_t> normal_;
 };

@@ -158,12 +158,14 @@ void Job::run() {
       std::min(v.get_float("clip_end"), double(std::numeric_limits<float>::max())));
 
   progress.set_stage(0.0, 0.05);
-  Frame frame(camera, width, height);
+  Frame& frame = frame_;
+  frame.reset(camera, width, height);
   frame.build(in, tiles, progress);
 
   const std::unique_ptr<Variant> variant = find_variant(v.get_string("variant")).create(v, frame);
   progress.set_stage(0.05, 0.95);
-  std::vector<float> visibility(size_t(width) * size_t(height), 1.0f);
+  std::vector<float>& visibility = visibility_;
+  visibility.assign(size_t(width) * size_t(height), 1.0f);
   tiles.for_each_tile(width, height, progress, [&](const Tile& t) {
     // A tile of background costs one pass over its depths.
     if (frame.geometry_count(t.x0, t.y0, t.x1, t.y1) == 0) return;
@@ -182,11 +184,12 @@ void Job::run() {
       static_cast<float>(v.get_float("remap_min")), static_cast<float>(v.get_float("remap_max"))};
   Progress uncancellable(nullptr, nullptr);
   tiles.for_each_tile(width, height, uncancellable, [&](const Tile& t) {
+    std::vector<float> denoised(size_t(t.x1 - t.x0) * size_t(t.y1 - t.y0));
+    denoiser.vertical_pass(visibility.data(), t, denoised.data());
+    const float* value = denoised.data();
     for (int y = t.y0; y < t.y1; ++y) {
-      for (int x = t.x0; x < t.x1; ++x) {
-        const float ao = frame.is_geometry(x, y)
-                             ? shaping.apply(denoiser.vertical(visibility.data(), x, y))
-                             : 1.0f;
+      for (int x = t.x0; x < t.x1; ++x, ++value) {
+        const float ao = frame.is_geometry(x, y) ? shaping.apply(*value) : 1.0f;
         if (ao_out_.attached()) {
           float* out = ao_out_.pixel(x, y);
           for (int c = 0; c < std::min(ao_out_.channels, 3); ++c) out[c] = ao;

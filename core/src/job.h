@@ -5,7 +5,9 @@
 
 #include <memory>
 #include <string>
+#include <vector>
 
+#include "frame.h"
 #include "image_view.h"
 #include "params.h"
 #include "tiles.h"
@@ -31,7 +33,11 @@ class Job {
   TilePool& pool(int threads);
 
   ParamValues params_;
-  std::unique_ptr<TilePool> pool_;  // kept between runs: its threads are started once
+  // Kept between runs: the pool's threads start once, and the frame planes and the visibility
+  // buffer (the library's only image-size buffers) are allocated once per image size.
+  std::unique_ptr<TilePool> pool_;
+  Frame frame_;
+  std::vector<float> visibility_;
   ImageView depth_, normal_, beauty_, ao_out_, composite_out_;
   Progress::Callback progress_callback_ = nullptr;
   void* progress_user_ = nullptr;

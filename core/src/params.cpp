@@ -37,7 +37,8 @@ const std::vector<ssao_param_desc>& table() {
       float_param("radius", 1.0, 1e-6, 1e9, "scene units",
                   "distance within which geometry occludes, as Cycles' AO distance"),
       string_param("quality", "medium", "low|medium|high|ultra",
-                   "sample counts of the variant (samples, slices, steps) that are left at 0"),
+                   "sample counts of the variant (samples, slices, steps) that are left at 0; "
+                   "medium is the measured balance of time and error"),
       int_param("samples", 0, 0, 1024, "directions per pixel",
                 "hemisphere: kernel directions per pixel; sphere: points per pixel; 0: from "
                 "quality"),
@@ -50,10 +51,10 @@ const std::vector<ssao_param_desc>& table() {
       float_param("bias", 0.02, 0.0, 1.0, "fraction of radius",
                   "height above the receiver's tangent plane (hemisphere, horizon) or behind the "
                   "sample (sphere) an occluder needs to count; one pixel footprint is added"),
-      float_param("sample_clustering", 1.0, 0.0, 4.0, "exponent",
+      float_param("sample_clustering", 0.6, 0.0, 4.0, "exponent",
                   "samples sit at radius * lerp(0.1, 1, s^p) for s uniform in [0,1): 0 puts all "
                   "on the kernel's surface, 2 clusters them toward the centre as the seed code "
-                  "does"),
+                  "does (measured)"),
       float_param(
           "thickness", 0.5, 0.01, 100.0, "fraction of radius",
           "assumed thickness of surfaces: horizon: an occluder spans this far behind the visible "

@@ -171,7 +171,7 @@ class SpeedupTest(unittest.TestCase):
             back = list(csv.DictReader(f))
         self.assertEqual([r["setting"] for r in back], [r["setting"] for r in rows])
         self.assertTrue(all(r["rmse"] == "0.05" and None not in r.values() for r in back))
-        self.assertIn("samples=8,steps=3", [r["setting"] for r in back])
+        self.assertIn("samples=16,steps=6,clustering=1", [r["setting"] for r in back])
 
     def test_unmeasurable_rmse(self):
         self.assertEqual(speed_error.cycles_time_to(float("nan"), self.CYCLES)[1], "?")

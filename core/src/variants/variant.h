@@ -21,6 +21,11 @@ class Variant {
   // Writes the raw visibility of every pixel of the tile to visibility[frame.index(x, y)]; a
   // pixel that is not a receiver (below) gets 1.
   virtual void estimate(const Frame& frame, const Tile& tile, float* visibility) const = 0;
+  // The same with the scalar reference code, where the variant has a vectorised fast path:
+  // the tests' oracle for it.
+  virtual void estimate_reference(const Frame& frame, const Tile& tile, float* visibility) const {
+    estimate(frame, tile, visibility);
+  }
 };
 
 struct VariantInfo {
