@@ -34,11 +34,4 @@ CameraModel::CameraModel(const CameraParams& p, int width, int height)
   center_v_ = static_cast<float>(0.5 * h + p.shift_y * view_factor / y_correction);
 }
 
-float CameraModel::radial_factor(float u, float v) const {
-  if (orthographic_) return 1.0f;
-  const float x = (u - center_u_) * scale_u_;
-  const float y = (center_v_ - v) * scale_v_;
-  return std::sqrt(x * x + y * y + 1.0f);
-}
-
 }  // namespace ssao

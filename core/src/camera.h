@@ -62,9 +62,6 @@ class CameraModel {
     return true;
   }
 
-  // Length of the ray to the pixel centre per unit of planar depth: radial = planar * factor.
-  float radial_factor(float u, float v) const;
-
   // Direction from the point towards the camera (unit), for orienting normals.
   Vec3 towards_camera(Vec3 p) const {
     return orthographic_ ? Vec3{0.0f, 0.0f, 1.0f} : normalize_or(-p, Vec3{0.0f, 0.0f, 1.0f});

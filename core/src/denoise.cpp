@@ -137,6 +137,7 @@ void Denoiser::horizontal_pass(float* visibility, TilePool& pool, Progress& prog
   if (mode_ == DenoiseMode::none) return;
   const int width = f_.width();
   pool.for_each_row_band(width, f_.height(), 8, progress, [&](const Tile& t) {
+    if (f_.geometry_count(0, t.y0, width, t.y1) == 0) return;  // sky keeps its value
     const GeometryBlock g(f_, radius_, -kApron, t.y0, width + kApron, t.y1);
     // The row with an apron of background on either side, and its filtered copy.
     std::vector<float> row(size_t(width) + 2 * kApron, 1.0f);
@@ -152,7 +153,7 @@ void Denoiser::horizontal_pass(float* visibility, TilePool& pool, Progress& prog
 
 void Denoiser::vertical_pass(const float* visibility, const Tile& t, float* out) const {
   const int width = t.x1 - t.x0;
-  if (mode_ == DenoiseMode::none) {
+  if (mode_ == DenoiseMode::none || f_.geometry_count(t.x0, t.y0, t.x1, t.y1) == 0) {
     for (int y = t.y0; y < t.y1; ++y) {
       std::copy_n(visibility + f_.index(t.x0, y), width, out + size_t(y - t.y0) * width);
     }

@@ -1,21 +1,12 @@
 // SPDX-License-Identifier: MIT
 #include "frame.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include "simd.h"
 
 namespace ssao {
-namespace {
-
-bool is_background_depth(float d, const FrameInputs& in) {
-  if (!std::isfinite(d) || !(d > 0.0f)) return true;
-  if (d >= in.background_depth) return true;
-  return in.clip_end > 0.0f && d >= in.clip_end;
-}
-
-}  // namespace
-
 void Frame::reset(const CameraModel& camera, int width, int height) {
   camera_ = camera;
   width_ = width;
@@ -33,15 +24,14 @@ size_t Frame::geometry_count(int x0, int y0, int x1, int y1) const {
 }
 
 void Frame::build(const FrameInputs& in, TilePool& pool, Progress& progress) {
+  // A depth at or beyond this is background (so are NaN, infinity and depths <= 0).
+  const float limit =
+      in.clip_end > 0.0f ? std::min(in.background_depth, in.clip_end) : in.background_depth;
   pool.for_each_tile(width_, height_, progress, [&](const Tile& t) {
     for (int y = t.y0; y < t.y1; ++y) {
-      for (int x = t.x0; x < t.x1; ++x) {
-        float d = in.depth.pixel(x, y)[0];
-        if (in.radial_depth && std::isfinite(d)) {
-          d /= camera_.radial_factor(float(x) + 0.5f, float(y) + 0.5f);
-        }
-        depth_[index(x, y)] = is_background_depth(d, in) ? kBackground : d;
-      }
+      float* row = depth_.data() + index(t.x0, y);
+      for (int x = t.x0; x < t.x1; ++x) row[x - t.x0] = in.depth.pixel(x, y)[0];
+      depth_row(row, t.x0, t.x1 - t.x0, float(y) + 0.5f, in.radial_depth, limit);
     }
   });
 
@@ -53,8 +43,13 @@ void Frame::build(const FrameInputs& in, TilePool& pool, Progress& progress) {
                             float(m[9]), float(m[2]), float(m[6]), float(m[10])};
   const float identity[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
   const float* rotation = in.world_normals ? to_view : identity;
+  const uint32_t facing = encode_normal({0.0f, 0.0f, 1.0f});
   pool.for_each_tile(width_, height_, progress, [&](const Tile& t) {
     const int count = t.x1 - t.x0;
+    if (geometry_count(t.x0, t.y0, t.x1, t.y1) == 0) {  // sky: nothing to orient
+      for (int y = t.y0; y < t.y1; ++y) std::fill_n(normal_.data() + index(t.x0, y), count, facing);
+      return;
+    }
     std::vector<float> nx(count, 0.0f), ny(count, 0.0f), nz(count, 0.0f);
     std::vector<uint32_t> usable(count);
     for (int y = t.y0; y < t.y1; ++y) {
@@ -110,6 +105,23 @@ SSAO_VECTORIZE void Frame::encode_normal_row(const float* rotation, float v, int
     const float flip = facing < 0.0f ? -1.0f : 1.0f;
     usable[i] = ok ? 1 : 0;
     out[i] = encode_normal({x * flip, y * flip, ok ? z * flip : 1.0f});
+  }
+}
+
+// Planar depth from the caller's values in place: radial ones divided by the ray length per unit
+// of planar depth, background marked. A loop without calls or branches, which the compiler
+// vectorises (NaN fails every comparison, so it is background).
+SSAO_VECTORIZE void Frame::depth_row(float* __restrict depth, int x0, int count, float v,
+                                     bool radial, float limit) const {
+  const CameraIntrinsics cam = camera_.intrinsics();
+  const float perspective_radial = radial && !cam.orthographic ? 1.0f : 0.0f;
+  const float y = (cam.center_v - v) * cam.scale_v;
+  for (int i = 0; i < count; ++i) {
+    const float x = (float(x0 + i) + 0.5f - cam.center_u) * cam.scale_u;
+    // radial = planar * sqrt(x^2 + y^2 + 1) at unit depth; 1 when not converting.
+    const float factor = std::sqrt(perspective_radial * (x * x + y * y) + 1.0f);
+    const float d = depth[i] / factor;
+    depth[i] = d > 0.0f && d < limit ? d : kBackground;
   }
 }
 

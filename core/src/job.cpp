@@ -10,6 +10,7 @@
 #include "denoise.h"
 #include "error.h"
 #include "frame.h"
+#include "simd.h"
 #include "variants/variant.h"
 
 namespace ssao {
@@ -44,12 +45,24 @@ DenoiseMode denoise_mode(const std::string& name) {
 }
 
 // Final AO from raw visibility: power, then strength, then the optional min/max remap.
+// Applied to a row in place; background (depth +inf) becomes 1. The part after the power is a
+// loop without calls or branches, which the compiler vectorises.
 struct Shaping {
   float power, strength, remap_min, remap_max;
-  float apply(float visibility) const {
-    const float shaped = power == 1.0f ? visibility : std::pow(visibility, power);
-    const float strong = 1.0f - strength * (1.0f - shaped);
-    return saturate(remap_min + (remap_max - remap_min) * strong);
+  void apply(const float* depth, float* values, int count) const {
+    if (power != 1.0f) {
+      for (int i = 0; i < count; ++i) values[i] = std::pow(values[i], power);
+    }
+    finish(depth, values, count, strength, remap_min, remap_max);
+  }
+  SSAO_VECTORIZE static void finish(const float* __restrict depth, float* __restrict values,
+                                    int count, float strength, float remap_min, float remap_max) {
+    for (int i = 0; i < count; ++i) {
+      const float strong = 1.0f - strength * (1.0f - values[i]);
+      const float mapped = remap_min + (remap_max - remap_min) * strong;
+      const float ao = mapped < 0.0f ? 0.0f : (mapped > 1.0f ? 1.0f : mapped);
+      values[i] = depth[i] != Frame::kBackground ? ao : 1.0f;
+    }
   }
 };
 
@@ -186,10 +199,12 @@ void Job::run() {
   tiles.for_each_tile(width, height, uncancellable, [&](const Tile& t) {
     std::vector<float> denoised(size_t(t.x1 - t.x0) * size_t(t.y1 - t.y0));
     denoiser.vertical_pass(visibility.data(), t, denoised.data());
-    const float* value = denoised.data();
+    const int count = t.x1 - t.x0;
     for (int y = t.y0; y < t.y1; ++y) {
-      for (int x = t.x0; x < t.x1; ++x, ++value) {
-        const float ao = frame.is_geometry(x, y) ? shaping.apply(*value) : 1.0f;
+      float* values = denoised.data() + size_t(y - t.y0) * count;
+      shaping.apply(frame.depth_plane() + frame.index(t.x0, y), values, count);
+      for (int x = t.x0; x < t.x1; ++x) {
+        const float ao = values[x - t.x0];
         if (ao_out_.attached()) {
           float* out = ao_out_.pixel(x, y);
           for (int c = 0; c < std::min(ao_out_.channels, 3); ++c) out[c] = ao;

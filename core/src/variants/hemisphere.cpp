@@ -58,6 +58,10 @@ void hemisphere_row(const HemisphereRowArgs& a, int y, int x0, int x1, float* ou
   const VF inf = hn::Set(df, std::numeric_limits<float>::infinity());
   const VF zero = hn::Zero(df), one = hn::Set(df, 1.0f), half = hn::Set(df, 0.5f);
   const VF two = hn::Set(df, 2.0f);
+  // View x of pixel column qx at unit depth is qx * scale_u + pixel_u0 (its centre), view y of
+  // row qy is pixel_v0 - qy * scale_v.
+  const VF pixel_u0 = hn::Set(df, (0.5f - cam.center_u) * cam.scale_u);
+  const VF pixel_v0 = hn::Set(df, (cam.center_v - 0.5f) * cam.scale_v);
   const VF scale_u = hn::Set(df, cam.scale_u), scale_v = hn::Set(df, cam.scale_v);
   const VF center_u = hn::Set(df, cam.center_u), center_v = hn::Set(df, cam.center_v);
   const VF inv_scale_u = hn::Set(df, 1.0f / cam.scale_u),
@@ -117,7 +121,9 @@ void hemisphere_row(const HemisphereRowArgs& a, int y, int x0, int x1, float* ou
     const VF tx = one + sign * nx * nx * basis_a, ty = sign * basis_c, tz = hn::Neg(sign * nx);
     const VF bx = basis_c, by = sign + ny * ny * basis_a, bz = hn::Neg(ny);
 
+    // An occluder counts above the tangent plane: dot(q, n) > dot(p, n) + min_height.
     const VF min_height = hn::Set(df, a.min_height_bias) + footprint;
+    const VF plane_level = hn::MulAdd(px, nx, hn::MulAdd(py, ny, hn::MulAdd(pz, nz, min_height)));
     VF occlusion = zero, valid = zero;
     const float* offset = row_offsets;
     for (int k = 0; k < a.directions; ++k) {
@@ -156,13 +162,13 @@ void hemisphere_row(const HemisphereRowArgs& a, int y, int x0, int x1, float* ou
         const VF qd = hn::GatherIndex(df, a.depth, index);
         // The visible surface at that pixel (Frame::position).
         const VF q_scale = cam.orthographic ? one : qd;
-        const VF qxv = (hn::ConvertTo(df, qx) + half - center_u) * scale_u * q_scale;
-        const VF qyv = (center_v - hn::ConvertTo(df, qy) - half) * scale_v * q_scale;
+        const VF qxv = hn::MulAdd(hn::ConvertTo(df, qx), scale_u, pixel_u0) * q_scale;
+        const VF qyv = hn::NegMulAdd(hn::ConvertTo(df, qy), scale_v, pixel_v0) * q_scale;
         const VF qzv = hn::Neg(qd);
         const VF behind = qzv - sz;  // > 0: the visible surface is in front of the sample
-        const VF height = (qxv - px) * nx + (qyv - py) * ny + (qzv - pz) * nz;
+        const VF level = hn::MulAdd(qxv, nx, hn::MulAdd(qyv, ny, qzv * nz));
         const auto counts = hn::And(hn::And(in_image, hn::Lt(qd, inf)),
-                                    hn::And(hn::Gt(behind, zero), hn::Gt(height, min_height)));
+                                    hn::And(hn::Gt(behind, zero), hn::Gt(level, plane_level)));
         const VF weight = hn::Min(one, hn::Max(zero, two - behind * inv_thickness));
         blocked = hn::Max(blocked, hn::IfThenElseZero(counts, weight));
       }
