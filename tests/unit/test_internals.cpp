@@ -190,18 +190,23 @@ TEST(CameraModel, MatchesBlendersProjection) {
 
 namespace {
 
+// The core's camera model of a test camera.
+ssao::CameraModel camera_model(const Camera& cam, int width, int height) {
+  ssao::CameraParams params;
+  params.orthographic = cam.ortho;
+  params.lens = cam.lens;
+  params.sensor_width = cam.sensor;
+  params.ortho_scale = cam.ortho_scale;
+  return ssao::CameraModel(params, width, height);
+}
+
 ssao_ref::DepthScene reference_scene(const Scene& s, const Camera& cam) {
   ssao_ref::DepthScene r;
   r.width = s.width;
   r.height = s.height;
   r.depth = s.depth;
   r.view_normal = s.normal;
-  ssao::CameraParams params;
-  params.orthographic = cam.ortho;
-  params.lens = cam.lens;
-  params.sensor_width = cam.sensor;
-  params.ortho_scale = cam.ortho_scale;
-  r.camera = ssao::CameraModel(params, s.width, s.height);
+  r.camera = camera_model(cam, s.width, s.height);
   return r;
 }
 
@@ -321,18 +326,13 @@ void prepare(PreparedFrame& out, const Camera& cam, const char* variant) {
   out.values.set_float("sensor_width", c.sensor);
   out.values.set_float("ortho_scale", c.ortho_scale);
   out.values.set_string("normal_space", "camera");
-  ssao::CameraParams params;
-  params.orthographic = c.ortho;
-  params.lens = c.lens;
-  params.sensor_width = c.sensor;
-  params.ortho_scale = c.ortho_scale;
   ssao::FrameInputs in;
   in.depth = {s.depth.data(), s.width, s.height, 1, 4, 4 * std::ptrdiff_t(s.width)};
   in.normal = {s.normal.data(), s.width, s.height, 3, 12, 12 * std::ptrdiff_t(s.width)};
   in.world_normals = false;
   ssao::TilePool pool(2);
   ssao::Progress progress(nullptr, nullptr);
-  out.frame.reset(ssao::CameraModel(params, s.width, s.height), s.width, s.height);
+  out.frame.reset(camera_model(c, s.width, s.height), s.width, s.height);
   out.frame.build(in, pool, progress);
 }
 

@@ -39,11 +39,7 @@ class Sphere final : public Variant {
   }
 
   void estimate(const Frame& f, const Tile& t, float* visibility) const override {
-    for (int y = t.y0; y < t.y1; ++y) {
-      for (int x = t.x0; x < t.x1; ++x) {
-        visibility[f.index(x, y)] = is_receiver(f, x, y, radius_) ? pixel(f, x, y) : 1.0f;
-      }
-    }
+    estimate_receivers(f, t, radius_, visibility, [&](int x, int y) { return pixel(f, x, y); });
   }
 
  private:

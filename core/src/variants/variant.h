@@ -54,6 +54,18 @@ inline bool is_receiver(const Frame& f, int x, int y, float radius) {
   return f.is_geometry(x, y) && radius >= 0.5f * f.camera().pixel_footprint(f.depth(x, y));
 }
 
+// Writes pixel(x, y) for every receiver of the tile and 1 for every other pixel: the scalar loop
+// of every variant.
+template <typename PixelFn>
+void estimate_receivers(const Frame& f, const Tile& t, float radius, float* visibility,
+                        PixelFn&& pixel) {
+  for (int y = t.y0; y < t.y1; ++y) {
+    for (int x = t.x0; x < t.x1; ++x) {
+      visibility[f.index(x, y)] = is_receiver(f, x, y, radius) ? pixel(x, y) : 1.0f;
+    }
+  }
+}
+
 // Looks up the surface seen through the pixel that view-space point s projects to. Returns false
 // when s falls outside the image (or behind a perspective camera): such a sample tells nothing.
 inline bool surface_behind_sample(const Frame& f, Vec3 s, bool& is_geometry, Vec3& surface) {
