@@ -45,7 +45,9 @@ NOISE_BORDER = (0.25, 0.75, 0.25, 0.75)
 
 # Library rows: (method, setting label, ssao_eval settings). "default" is the product's default.
 LIBRARY_FULL = [
-    ("hemisphere", "default", []),  # quality=medium
+    ("hemisphere", "default", []),  # quality=medium, resolution=auto
+    ("hemisphere", "resolution=full", ["resolution=full"]),
+    ("hemisphere", "resolution=half", ["resolution=half"]),
     ("hemisphere", "quality=low", ["quality=low"]),
     ("hemisphere", "quality=high", ["quality=high"]),
     ("hemisphere", "quality=ultra", ["quality=ultra"]),
@@ -351,7 +353,8 @@ def series_name(row):
     if row["method"] not in ("hemisphere", "sphere", "horizon"):
         return row["method"]
     extra = [part for part in row["setting"].split(",")
-             if part != "default" and not part.startswith(("samples=", "quality=", "steps="))
+             if part != "default"
+             and not part.startswith(("samples=", "quality=", "steps=", "resolution="))
              and not part.startswith("clustering=")]
     return " ".join([row["method"]] + extra)
 

@@ -33,6 +33,15 @@ class CameraModel {
   // Mirrors Blender's viewplane computation (BKE_camera_params_compute_viewplane).
   CameraModel(const CameraParams& params, int width, int height);
 
+  // The same camera on an image `factor` times coarser (pixel (i, j) covers pixels
+  // [factor i, factor (i + 1)) x [factor j, factor (j + 1)) of this one).
+  CameraModel coarser(int factor) const {
+    CameraModel c = *this;
+    c.scale_u_ *= float(factor), c.scale_v_ *= float(factor);
+    c.center_u_ /= float(factor), c.center_v_ /= float(factor);
+    return c;
+  }
+
   bool orthographic() const { return orthographic_; }
   CameraIntrinsics intrinsics() const {
     return {orthographic_, scale_u_, scale_v_, center_u_, center_v_};

@@ -133,6 +133,55 @@ constexpr int kApron = 2;
 
 }  // namespace
 
+// Pointers into the planes of one row of a GeometryBlock, plus the visibility of that row.
+struct RowPlanes {
+  const float *px, *py, *pz, *nx, *ny, *nz, *valid, *value;
+};
+
+RowPlanes row_planes(const GeometryBlock& g, int x, int y, const float* values) {
+  const size_t i = g.at(x, y);
+  return {&g.px[i], &g.py[i], &g.pz[i], &g.nx[i], &g.ny[i], &g.nz[i], &g.valid[i], values};
+}
+
+// The full-resolution pixels x = 2 k + parity (k = 0 .. count - 1) of one row, from the two
+// half-resolution rows around it. Half-resolution column c has its centre at full-resolution
+// 2 c + 1, so pixel 2 k + parity lies between half columns k - 1 + parity and k + parity,
+// weighted 3/4 : 1/4 toward the nearer; `low` and `high` are indexed so that [k] is column k
+// (and [-1] exists). Contiguous loads only: the loop vectorises.
+SSAO_VECTORIZE void upsample_run(const RowPlanes centre, const float* __restrict inv_scale,
+                                 const RowPlanes low, const RowPlanes high, float high_weight,
+                                 int parity, int count, float* __restrict out) {
+  const float low_weight = 1.0f - high_weight;
+  const float right_weight = parity ? 0.25f : 0.75f;
+  for (int k = 0; k < count; ++k) {
+    const int i = 2 * k;  // the pixel in the centre row's planes (which start at this parity)
+    const int left = k - 1 + parity, right = k + parity;
+    float sum = 0.0f, weight_sum = 0.0f;
+    // One half-resolution neighbour: bilinear weight, tangent-plane distance, normal agreement.
+    auto tap = [&](const RowPlanes& r, int c, float bilinear) {
+      const float plane = (r.px[c] - centre.px[i]) * centre.nx[i] +
+                          (r.py[c] - centre.py[i]) * centre.ny[i] +
+                          (r.pz[c] - centre.pz[i]) * centre.nz[i];
+      const float plane_distance = (plane < 0.0f ? -plane : plane) * inv_scale[i];
+      const float cosine = r.nx[c] * centre.nx[i] + r.ny[c] * centre.ny[i] + r.nz[c] * centre.nz[i];
+      const float agreement = cosine > 0.0f ? cosine : 0.0f;
+      const float a2 = agreement * agreement;
+      const float w =
+          r.valid[c] * (bilinear + 1e-3f) * a2 * a2 / (1.0f + plane_distance * plane_distance);
+      sum += w * r.value[c];
+      weight_sum += w;
+    };
+    tap(low, left, low_weight * (1.0f - right_weight));
+    tap(low, right, low_weight * right_weight);
+    tap(high, left, high_weight * (1.0f - right_weight));
+    tap(high, right, high_weight * right_weight);
+    // No neighbour on this surface (a one-pixel feature): the pixel's own block, k.
+    const float own = high_weight > 0.5f ? high.value[k] : low.value[k];
+    const float upsampled = weight_sum > 1e-6f ? sum / weight_sum : own;
+    out[k] = centre.valid[i] > 0.0f ? upsampled : 1.0f;
+  }
+}
+
 void Denoiser::horizontal_pass(float* visibility, TilePool& pool, Progress& progress) const {
   if (mode_ == DenoiseMode::none) return;
   const int width = f_.width();
@@ -172,6 +221,57 @@ void Denoiser::vertical_pass(const float* visibility, const Tile& t, float* out)
                column_apron.data() + size_t(y - t.y0 + kApron) * width, width, width,
                out + size_t(y - t.y0) * width);
   }
+}
+
+void upsample(const Frame& full, const Frame& half, const float* half_visibility, float radius,
+              const Tile& t, float* out) {
+  const int width = t.x1 - t.x0;
+  // Full-resolution planes of the tile, and half-resolution planes of the columns around it
+  // with one column of apron either side (outside the image: not geometry, weight 0).
+  const GeometryBlock centre(full, radius, t.x0, t.y0, t.x1, t.y1);
+  const int half_x0 = (t.x0 >> 1) - 1, half_x1 = ((t.x1 - 1) >> 1) + 2;
+  const int low_row0 = std::max(0, (t.y0 - 1) >> 1);
+  const int high_row1 = std::min(half.height(), ((t.y1 - 1) >> 1) + 2);
+  const GeometryBlock around(half, radius, half_x0, low_row0, half_x1, high_row1);
+  std::vector<float> values(size_t(half_x1 - half_x0) * size_t(high_row1 - low_row0), 1.0f);
+  for (int y = low_row0; y < high_row1; ++y) {
+    for (int x = std::max(half_x0, 0); x < std::min(half_x1, half.width()); ++x) {
+      values[around.at(x, y)] = half_visibility[half.index(x, y)];
+    }
+  }
+  std::vector<float> by_parity[2] = {std::vector<float>(size_t(width) / 2 + 1),
+                                     std::vector<float>(size_t(width) / 2 + 1)};
+  for (int y = t.y0; y < t.y1; ++y) {
+    const int low_raw = (y - 1) >> 1;
+    const int low = std::max(low_raw, 0), high = std::min(low_raw + 1, half.height() - 1);
+    for (int parity = 0; parity < 2; ++parity) {
+      // The first pixel of this parity, and its k = 0 half column.
+      const int x_first = t.x0 + ((t.x0 & 1) != parity ? 1 : 0);
+      const int count = x_first < t.x1 ? (t.x1 - x_first + 1) / 2 : 0;
+      if (count == 0) continue;
+      const int k0 = x_first >> 1;
+      upsample_run(row_planes(centre, x_first, y, nullptr),
+                   &centre.inv_scale[centre.at(x_first, y)],
+                   row_planes(around, k0, low, &values[around.at(k0, low)]),
+                   row_planes(around, k0, high, &values[around.at(k0, high)]),
+                   (y & 1) ? 0.25f : 0.75f, parity, count, by_parity[parity].data());
+      float* row = out + size_t(y - t.y0) * width;
+      for (int k = 0; k < count; ++k) row[x_first + 2 * k - t.x0] = by_parity[parity][k];
+    }
+  }
+}
+
+void Denoiser::vertical_pass_in_place(float* visibility, TilePool& pool, Progress& progress) const {
+  if (mode_ == DenoiseMode::none) return;
+  pool.for_each_column_band(f_.width(), f_.height(), 32, progress, [&](const Tile& t) {
+    // A band reads and writes only its own columns: filter into a copy, then write it back.
+    const int width = t.x1 - t.x0;
+    std::vector<float> filtered(size_t(width) * size_t(f_.height()));
+    vertical_pass(visibility, t, filtered.data());
+    for (int y = 0; y < f_.height(); ++y) {
+      std::copy_n(filtered.data() + size_t(y) * width, width, visibility + f_.index(t.x0, y));
+    }
+  });
 }
 
 }  // namespace ssao

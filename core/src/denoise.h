@@ -26,11 +26,22 @@ class Denoiser {
   // The vertical pass over one tile, reading the horizontally filtered visibility; writes
   // out[(y - t.y0) * (t.x1 - t.x0) + (x - t.x0)].
   void vertical_pass(const float* visibility, const Tile& t, float* out) const;
+  // The vertical pass over the whole image, in place (bands of columns).
+  void vertical_pass_in_place(float* visibility, TilePool& pool, Progress& progress) const;
 
  private:
   const Frame& f_;
   DenoiseMode mode_;
   float radius_;
 };
+
+// Joint bilateral upsampling of a half-resolution estimate (resolution = half): the visibility
+// of the full-resolution pixels of tile t into out (tile-local rows), from the visibility of
+// `half` (made by Frame::downsample of `full`). Each pixel takes the four half-resolution
+// pixels around it, weighted bilinearly and, as the bilateral filter weighs, by their distance
+// from the pixel's tangent plane and their normals' agreement, so AO does not leak across
+// silhouettes. Background pixels get 1.
+void upsample(const Frame& full, const Frame& half, const float* half_visibility, float radius,
+              const Tile& t, float* out);
 
 }  // namespace ssao

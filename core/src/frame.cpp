@@ -108,6 +108,30 @@ SSAO_VECTORIZE void Frame::encode_normal_row(const float* rotation, float v, int
   }
 }
 
+void Frame::downsample(const Frame& full, TilePool& pool, Progress& progress) {
+  reset(full.camera().coarser(2), (full.width() + 1) / 2, (full.height() + 1) / 2);
+  pool.for_each_tile(width_, height_, progress, [&](const Tile& t) {
+    for (int y = t.y0; y < t.y1; ++y) {
+      for (int x = t.x0; x < t.x1; ++x) {
+        // The nearest pixel of the block: thin foreground survives, and a block on a
+        // silhouette takes one surface's depth and normal, never a blend of two.
+        size_t best = 0;
+        float nearest = kBackground;
+        for (int dy = 0; dy < 2; ++dy) {
+          for (int dx = 0; dx < 2; ++dx) {
+            const int fx = 2 * x + dx, fy = 2 * y + dy;
+            if (fx >= full.width() || fy >= full.height()) continue;
+            const size_t i = full.index(fx, fy);
+            if (full.depth_[i] < nearest) nearest = full.depth_[i], best = i;
+          }
+        }
+        depth_[index(x, y)] = nearest;
+        normal_[index(x, y)] = full.normal_[best];
+      }
+    }
+  });
+}
+
 // Planar depth from the caller's values in place: radial ones divided by the ray length per unit
 // of planar depth, background marked. A loop without calls or branches, which the compiler
 // vectorises (NaN fails every comparison, so it is background).

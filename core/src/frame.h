@@ -67,6 +67,11 @@ class Frame {
   // Fills the depth plane, then the normals (from the normal image or reconstructed from depth).
   void build(const FrameInputs& in, TilePool& pool, Progress& progress);
 
+  // This frame at half resolution: each 2x2 block becomes one pixel with the depth and normal
+  // of its nearest geometry pixel (background if it has none), seen through full.camera()
+  // made twice as coarse.
+  void downsample(const Frame& full, TilePool& pool, Progress& progress);
+
   int width() const { return width_; }
   int height() const { return height_; }
   const CameraModel& camera() const { return camera_; }

@@ -66,6 +66,11 @@ struct Shaping {
   }
 };
 
+// resolution = auto estimates at half resolution from this many pixels on. Measured with the
+// benchmark against Cycles' AO pass: at 1920x1080 half resolution costs 0.0005 of mean RMSE
+// (at 1.6x the speed); at 640x360, 0.002 (pixels there are large next to contact shadows).
+constexpr double kHalfResolutionPixels = 1e6;
+
 }  // namespace
 
 void Job::set_image(const char* name, float* data, int width, int height, int channels,
@@ -175,20 +180,30 @@ void Job::run() {
   frame.reset(camera, width, height);
   frame.build(in, tiles, progress);
 
-  const std::unique_ptr<Variant> variant = find_variant(v.get_string("variant")).create(v, frame);
+  // The frame the variant sees: the input's, or a half-resolution copy (a quarter of the work;
+  // the result is upsampled at the output).
+  const std::string& resolution = v.get_string("resolution");
+  const bool half_resolution =
+      resolution == "half" ||
+      (resolution == "auto" && double(width) * double(height) >= kHalfResolutionPixels);
+  if (half_resolution) half_frame_.downsample(frame, tiles, progress);
+  const Frame& seen = half_resolution ? half_frame_ : frame;
+
+  const std::unique_ptr<Variant> variant = find_variant(v.get_string("variant")).create(v, seen);
   progress.set_stage(0.05, 0.95);
   std::vector<float>& visibility = visibility_;
-  visibility.assign(size_t(width) * size_t(height), 1.0f);
-  tiles.for_each_tile(width, height, progress, [&](const Tile& t) {
+  visibility.assign(size_t(seen.width()) * size_t(seen.height()), 1.0f);
+  tiles.for_each_tile(seen.width(), seen.height(), progress, [&](const Tile& t) {
     // A tile of background costs one pass over its depths.
-    if (frame.geometry_count(t.x0, t.y0, t.x1, t.y1) == 0) return;
-    variant->estimate(frame, t, visibility.data());
+    if (seen.geometry_count(t.x0, t.y0, t.x1, t.y1) == 0) return;
+    variant->estimate(seen, t, visibility.data());
   });
 
   const float radius = static_cast<float>(v.get_float("radius"));
-  const Denoiser denoiser(frame, denoise_mode(v.get_string("denoise")), radius);
+  const Denoiser denoiser(seen, denoise_mode(v.get_string("denoise")), radius);
   progress.set_stage(0.95, 1.0);
   denoiser.horizontal_pass(visibility.data(), tiles, progress);
+  if (half_resolution) denoiser.vertical_pass_in_place(visibility.data(), tiles, progress);
 
   // Outputs are written only now, after every cancellable stage succeeded: a failed or
   // cancelled run leaves the caller's buffers untouched. This last stage cannot be cancelled.
@@ -198,7 +213,11 @@ void Job::run() {
   Progress uncancellable(nullptr, nullptr);
   tiles.for_each_tile(width, height, uncancellable, [&](const Tile& t) {
     std::vector<float> denoised(size_t(t.x1 - t.x0) * size_t(t.y1 - t.y0));
-    denoiser.vertical_pass(visibility.data(), t, denoised.data());
+    if (half_resolution) {
+      upsample(frame, half_frame_, visibility.data(), radius, t, denoised.data());
+    } else {
+      denoiser.vertical_pass(visibility.data(), t, denoised.data());
+    }
     const int count = t.x1 - t.x0;
     for (int y = t.y0; y < t.y1; ++y) {
       float* values = denoised.data() + size_t(y - t.y0) * count;

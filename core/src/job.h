@@ -34,9 +34,10 @@ class Job {
 
   ParamValues params_;
   // Kept between runs: the pool's threads start once, and the frame planes and the visibility
-  // buffer (the library's only image-size buffers) are allocated once per image size.
+  // buffer (the library's only image-size buffers; with resolution = half, the half frame's
+  // planes and a quarter-size visibility) are allocated once per image size.
   std::unique_ptr<TilePool> pool_;
-  Frame frame_;
+  Frame frame_, half_frame_;
   std::vector<float> visibility_;
   ImageView depth_, normal_, beauty_, ao_out_, composite_out_;
   Progress::Callback progress_callback_ = nullptr;

@@ -64,6 +64,11 @@ const std::vector<ssao_param_desc>& table() {
                    "sphere variant: classic reads about 0.5 on a flat wall; normalized maps an "
                    "unoccluded flat surface to 1"),
       int_param("seed", 0, 0, 2147483647, "", "seed of the kernel rotation pattern"),
+      string_param("resolution", "auto", "auto|full|half",
+                   "full: AO estimated at every pixel; half: at half resolution in each axis (a "
+                   "quarter of the work), then upsampled guided by depth and normals; auto: half "
+                   "for frames of at least 1 megapixel, where it costs almost no accuracy "
+                   "(measured)"),
       // --- denoising ---
       string_param("denoise", "bilateral", "bilateral|box4|none",
                    "bilateral: depth- and normal-aware blur; box4: the seed code's 4x4 box blur; "
