@@ -17,8 +17,8 @@ from . import pipeline, ssao_native
 
 # Library parameters the node exposes, by their library names (the rest are set by the add-on:
 # camera, conventions, threads).
-NODE_PARAMETERS = ("variant", "radius", "quality", "samples", "slices", "steps", "bias",
-                   "thickness", "sample_clustering", "sphere_mode", "denoise", "strength",
+NODE_PARAMETERS = ("variant", "radius", "quality", "resolution", "samples", "slices", "steps",
+                   "bias", "thickness", "sample_clustering", "sphere_mode", "denoise", "strength",
                    "power", "remap_min", "remap_max", "seed")
 
 EXPORT_NODE, AO_NODE, MULTIPLY_NODE = "SSAO Export", "SSAO AO", "SSAO Multiply"

@@ -188,11 +188,16 @@ void Job::run() {
       (resolution == "auto" && double(width) * double(height) >= kHalfResolutionPixels);
   if (half_resolution) half_frame_.downsample(frame, tiles, progress);
   const Frame& seen = half_resolution ? half_frame_ : frame;
+  // At most three image-size buffers: the full frame's two planes and one of visibility (or the
+  // half frame's planes and visibility, a quarter each). What the other mode kept is freed.
+  if (!half_resolution) half_frame_ = Frame();
+  const size_t estimates = size_t(seen.width()) * size_t(seen.height());
+  if (visibility_.capacity() > estimates) std::vector<float>().swap(visibility_);
 
   const std::unique_ptr<Variant> variant = find_variant(v.get_string("variant")).create(v, seen);
   progress.set_stage(0.05, 0.95);
   std::vector<float>& visibility = visibility_;
-  visibility.assign(size_t(seen.width()) * size_t(seen.height()), 1.0f);
+  visibility.assign(estimates, 1.0f);
   tiles.for_each_tile(seen.width(), seen.height(), progress, [&](const Tile& t) {
     // A tile of background costs one pass over its depths.
     if (seen.geometry_count(t.x0, t.y0, t.x1, t.y1) == 0) return;
@@ -213,7 +218,9 @@ void Job::run() {
   Progress uncancellable(nullptr, nullptr);
   tiles.for_each_tile(width, height, uncancellable, [&](const Tile& t) {
     std::vector<float> denoised(size_t(t.x1 - t.x0) * size_t(t.y1 - t.y0));
-    if (half_resolution) {
+    if (frame.geometry_count(t.x0, t.y0, t.x1, t.y1) == 0) {
+      std::fill(denoised.begin(), denoised.end(), 1.0f);  // sky
+    } else if (half_resolution) {
       upsample(frame, half_frame_, visibility.data(), radius, t, denoised.data());
     } else {
       denoiser.vertical_pass(visibility.data(), t, denoised.data());
