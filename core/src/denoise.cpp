@@ -69,6 +69,20 @@ struct GeometryBlock {
 
 constexpr float kBilateralTaps[5] = {0.5f, 1.0f, 1.0f, 1.0f, 0.5f};
 
+// How much neighbour q may speak for centre p (the bilateral's and the upsampling's weight):
+// low when q lies off p's tangent plane (in units of p's plane scale) or when their normals
+// disagree; 0 when q is not geometry. Inline and branch-free, so the callers' loops vectorise.
+inline float surface_weight(float px, float py, float pz, float nx, float ny, float nz,
+                            float inv_scale, float qx, float qy, float qz, float qnx, float qny,
+                            float qnz, float q_valid) {
+  const float plane = (qx - px) * nx + (qy - py) * ny + (qz - pz) * nz;
+  const float plane_distance = (plane < 0.0f ? -plane : plane) * inv_scale;
+  const float cosine = qnx * nx + qny * ny + qnz * nz;
+  const float agreement = cosine > 0.0f ? cosine : 0.0f;
+  const float a2 = agreement * agreement;
+  return q_valid * a2 * a2 / (1.0f + plane_distance * plane_distance);
+}
+
 // Filters `count` pixels starting at block index `centre`; the taps are `stride` apart in the
 // block and in `in` (whose first centre value is in[0]). Loops without calls or branches, which
 // the compiler vectorises.
@@ -88,14 +102,9 @@ SSAO_VECTORIZE void bilateral_run(const GeometryBlock& g, size_t centre, ptrdiff
 #pragma GCC unroll 5
     for (int d = -2; d <= 2; ++d) {
       const ptrdiff_t q = i + d * stride;
-      const float plane =
-          (px[q] - px[i]) * nx[i] + (py[q] - py[i]) * ny[i] + (pz[q] - pz[i]) * nz[i];
-      const float plane_distance = (plane < 0.0f ? -plane : plane) * inv_scale[i];
-      const float cosine = nx[q] * nx[i] + ny[q] * ny[i] + nz[q] * nz[i];
-      const float agreement = cosine > 0.0f ? cosine : 0.0f;
-      const float a2 = agreement * agreement;
-      const float w =
-          valid[q] * kBilateralTaps[d + 2] * a2 * a2 / (1.0f + plane_distance * plane_distance);
+      const float w = kBilateralTaps[d + 2] * surface_weight(px[i], py[i], pz[i], nx[i], ny[i],
+                                                             nz[i], inv_scale[i], px[q], py[q],
+                                                             pz[q], nx[q], ny[q], nz[q], valid[q]);
       sum += w * in[i + d * in_stride];
       weight_sum += w;
     }
@@ -159,15 +168,10 @@ SSAO_VECTORIZE void upsample_run(const RowPlanes centre, const float* __restrict
     float sum = 0.0f, weight_sum = 0.0f;
     // One half-resolution neighbour: bilinear weight, tangent-plane distance, normal agreement.
     auto tap = [&](const RowPlanes& r, int c, float bilinear) {
-      const float plane = (r.px[c] - centre.px[i]) * centre.nx[i] +
-                          (r.py[c] - centre.py[i]) * centre.ny[i] +
-                          (r.pz[c] - centre.pz[i]) * centre.nz[i];
-      const float plane_distance = (plane < 0.0f ? -plane : plane) * inv_scale[i];
-      const float cosine = r.nx[c] * centre.nx[i] + r.ny[c] * centre.ny[i] + r.nz[c] * centre.nz[i];
-      const float agreement = cosine > 0.0f ? cosine : 0.0f;
-      const float a2 = agreement * agreement;
-      const float w =
-          r.valid[c] * (bilinear + 1e-3f) * a2 * a2 / (1.0f + plane_distance * plane_distance);
+      const float w = (bilinear + 1e-3f) * surface_weight(centre.px[i], centre.py[i], centre.pz[i],
+                                                          centre.nx[i], centre.ny[i], centre.nz[i],
+                                                          inv_scale[i], r.px[c], r.py[c], r.pz[c],
+                                                          r.nx[c], r.ny[c], r.nz[c], r.valid[c]);
       sum += w * r.value[c];
       weight_sum += w;
     };
@@ -186,7 +190,7 @@ void Denoiser::horizontal_pass(float* visibility, TilePool& pool, Progress& prog
   if (mode_ == DenoiseMode::none) return;
   const int width = f_.width();
   pool.for_each_row_band(width, f_.height(), 8, progress, [&](const Tile& t) {
-    if (f_.geometry_count(0, t.y0, width, t.y1) == 0) return;  // sky keeps its value
+    if (!f_.has_geometry(0, t.y0, width, t.y1)) return;  // sky keeps its value
     const GeometryBlock g(f_, radius_, -kApron, t.y0, width + kApron, t.y1);
     // The row with an apron of background on either side, and its filtered copy.
     std::vector<float> row(size_t(width) + 2 * kApron, 1.0f);
@@ -202,14 +206,14 @@ void Denoiser::horizontal_pass(float* visibility, TilePool& pool, Progress& prog
 
 void Denoiser::vertical_pass(const float* visibility, const Tile& t, float* out) const {
   const int width = t.x1 - t.x0;
-  if (mode_ == DenoiseMode::none || f_.geometry_count(t.x0, t.y0, t.x1, t.y1) == 0) {
+  if (mode_ == DenoiseMode::none || !f_.has_geometry(t.x0, t.y0, t.x1, t.y1)) {
     for (int y = t.y0; y < t.y1; ++y) {
       std::copy_n(visibility + f_.index(t.x0, y), width, out + size_t(y - t.y0) * width);
     }
     return;
   }
   const GeometryBlock g(f_, radius_, t.x0, t.y0 - kApron, t.x1, t.y1 + kApron);
-  // Rows outside the image are read with weight 0: point them at a valid row.
+  // Rows outside the image are not geometry (weight 0); their values are a placeholder 1.
   std::vector<float> column_apron(size_t(width) * (t.y1 - t.y0 + 2 * kApron), 1.0f);
   for (int y = t.y0 - kApron; y < t.y1 + kApron; ++y) {
     if (y < 0 || y >= f_.height()) continue;

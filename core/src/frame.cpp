@@ -15,12 +15,13 @@ void Frame::reset(const CameraModel& camera, int width, int height) {
   normal_.resize(size_t(width) * size_t(height));
 }
 
-size_t Frame::geometry_count(int x0, int y0, int x1, int y1) const {
-  size_t count = 0;
+bool Frame::has_geometry(int x0, int y0, int x1, int y1) const {
   for (int y = y0; y < y1; ++y) {
-    for (int x = x0; x < x1; ++x) count += is_geometry(x, y) ? 1 : 0;
+    for (int x = x0; x < x1; ++x) {
+      if (is_geometry(x, y)) return true;
+    }
   }
-  return count;
+  return false;
 }
 
 void Frame::build(const FrameInputs& in, TilePool& pool, Progress& progress) {
@@ -46,7 +47,7 @@ void Frame::build(const FrameInputs& in, TilePool& pool, Progress& progress) {
   const uint32_t facing = encode_normal({0.0f, 0.0f, 1.0f});
   pool.for_each_tile(width_, height_, progress, [&](const Tile& t) {
     const int count = t.x1 - t.x0;
-    if (geometry_count(t.x0, t.y0, t.x1, t.y1) == 0) {  // sky: nothing to orient
+    if (!has_geometry(t.x0, t.y0, t.x1, t.y1)) {  // sky: nothing to orient
       for (int y = t.y0; y < t.y1; ++y) std::fill_n(normal_.data() + index(t.x0, y), count, facing);
       return;
     }
@@ -66,10 +67,7 @@ void Frame::build(const FrameInputs& in, TilePool& pool, Progress& progress) {
       // silhouettes) falls back to the depth-reconstructed one.
       for (int i = 0; i < count; ++i) {
         if (usable[i] || depth_[row + i] == kBackground) continue;
-        const int x = t.x0 + i;
-        Vec3 n = reconstructed_normal(x, y);
-        if (dot(n, camera_.towards_camera(position(x, y))) < 0.0f) n = -n;
-        normal_[row + i] = encode_normal(n);
+        normal_[row + i] = encode_normal(reconstructed_normal(t.x0 + i, y));  // faces the camera
       }
     }
   });

@@ -87,8 +87,8 @@ class Frame {
   Vec3 normal(int x, int y) const { return decode_normal(normal_[index(x, y)]); }
   const uint32_t* normal_plane() const { return normal_.data(); }
 
-  // Pixels of geometry in rows [y0, y1) x columns [x0, x1).
-  size_t geometry_count(int x0, int y0, int x1, int y1) const;
+  // Whether rows [y0, y1) x columns [x0, x1) show any geometry (false: all sky).
+  bool has_geometry(int x0, int y0, int x1, int y1) const;
 
  private:
   Vec3 reconstructed_normal(int x, int y) const;

@@ -200,7 +200,7 @@ void Job::run() {
   visibility.assign(estimates, 1.0f);
   tiles.for_each_tile(seen.width(), seen.height(), progress, [&](const Tile& t) {
     // A tile of background costs one pass over its depths.
-    if (seen.geometry_count(t.x0, t.y0, t.x1, t.y1) == 0) return;
+    if (!seen.has_geometry(t.x0, t.y0, t.x1, t.y1)) return;
     variant->estimate(seen, t, visibility.data());
   });
 
@@ -218,7 +218,7 @@ void Job::run() {
   Progress uncancellable(nullptr, nullptr);
   tiles.for_each_tile(width, height, uncancellable, [&](const Tile& t) {
     std::vector<float> denoised(size_t(t.x1 - t.x0) * size_t(t.y1 - t.y0));
-    if (frame.geometry_count(t.x0, t.y0, t.x1, t.y1) == 0) {
+    if (!frame.has_geometry(t.x0, t.y0, t.x1, t.y1)) {
       std::fill(denoised.begin(), denoised.end(), 1.0f);  // sky
     } else if (half_resolution) {
       upsample(frame, half_frame_, visibility.data(), radius, t, denoised.data());
