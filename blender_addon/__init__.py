@@ -2,8 +2,12 @@
 """Ambient Occlusion (SSAO) compositor node, computed by libssao from the Depth and Normal passes.
 
 Blender 3.x installs this folder (zipped) as a legacy add-on (bl_info); Blender 4.2+ installs
-the same zip as an extension (blender_manifest.toml). All imports are relative.
-"""
+the same zip as an extension (blender_manifest.toml). All imports are relative. The version here
+and in the manifest is the project's (CMakeLists.txt), written in when the zip is packaged.
+
+Modules: node (the node type), inner_tree (its built-in inner nodes), compute (libssao),
+recomposite (running the compositor again), multilayer (EXR layers), handlers (render and file
+events), operators, preferences, camera, compat (every Blender-version difference)."""
 
 bl_info = {
     "name": "Ambient Occlusion (SSAO) compositor node",
@@ -15,12 +19,12 @@ bl_info = {
     "category": "Compositing",
 }
 
-from . import node, operators, pipeline  # noqa: E402
+from . import compute, handlers, node, operators, preferences  # noqa: E402
 
 # Scripting entry point: ssao_compositor.compute_ao(scene) -> numpy array (height, width).
-compute_ao = pipeline.compute_ao
+compute_ao = compute.compute_ao
 
-_modules = (node, pipeline, operators)
+_modules = (preferences, node, handlers, operators)
 
 
 def register():

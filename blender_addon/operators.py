@@ -2,7 +2,7 @@
 """Operators: recompute the AO of the scene's SSAO nodes from the last render's passes."""
 import bpy
 
-from . import pipeline
+from . import compute, inner_tree
 
 
 class SSAO_OT_recompute(bpy.types.Operator):
@@ -14,16 +14,16 @@ class SSAO_OT_recompute(bpy.types.Operator):
 
     @classmethod
     def poll(cls, context):
-        return context.scene is not None and bool(pipeline.ssao_nodes(context.scene))
+        return context.scene is not None and bool(compute.ssao_nodes(context.scene))
 
     def execute(self, context):
         scene = context.scene
-        if pipeline.compute_frame(scene, scene.frame_current) == 0:
-            errors = [n.status for n in pipeline.ssao_nodes(scene)]
+        if not compute.compute_frame(scene, scene.frame_current):
+            errors = [n.status for n in compute.ssao_nodes(scene)]
             self.report({'ERROR'}, "; ".join(errors) or "nothing to compute")
             return {'CANCELLED'}
-        for node in pipeline.ssao_nodes(scene):
-            pipeline.nudge_compositor(node)
+        for node in compute.ssao_nodes(scene):
+            inner_tree.nudge(node)
         self.report({'INFO'}, "SSAO recomputed")
         return {'FINISHED'}
 

@@ -14,7 +14,8 @@ PACKAGES=(
   python3-matplotlib                        # benchmark plots (scripts/benchmark.sh)
   blender                                   # ground truth renders (Cycles AO pass)
   povray povray-examples                    # the POV-Ray bridge and its test scenes
-  debootstrap                               # Blender 4.3 tests (a Debian 13 folder)
+  debootstrap                               # Blender 4.3 and 5.2 tests (Debian 13 and sid folders)
+  xvfb xauth                                # the add-on tests in Blender's UI (xvfb-run)
 )
 
 missing=()

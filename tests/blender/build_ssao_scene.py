@@ -7,8 +7,10 @@ Ambient Occlusion (SSAO) node in the compositor and saves it as a .blend.
         [--camera persp|ortho] [--width 160 --height 90 --samples 16] [--frames 1]
         [--output //render_####.png] [--ao-pass] [--radius 0.8]
 
-The compositor: Render Layers (Image, Depth, Normal) -> SSAO -> Composite; the SSAO node's AO
-output also goes to a Viewer. With --frames N the camera moves over frames 1..N.
+The compositor: Render Layers (Image, Depth, Normal) -> SSAO -> Composite (Group Output in 5.x);
+the SSAO node's AO output also goes to a Viewer. With --frames N the camera moves over frames
+1..N. The compositor is built the way of the running Blender through the add-on's own version
+shims (its compat module), which this also tests.
 """
 import argparse
 import os
@@ -33,11 +35,19 @@ def parse_args():
     parser.add_argument("--frames", type=int, default=1)
     parser.add_argument("--radius", type=float, default=0.8)
     parser.add_argument("--output", default="//render_####.png")
+    parser.add_argument("--compositor-device", choices=("default", "CPU", "GPU"),
+                        default="default", help="render.compositor_device (Blender 4.2+)")
+    parser.add_argument("--format", choices=("auto", "OPEN_EXR_MULTILAYER"), default="auto",
+                        help="output format (auto: from --output's extension)")
     parser.add_argument("--ao-pass", action="store_true", help="also render Cycles' AO pass")
     parser.add_argument("--passes-dir", default=None,
                         help="also write Image, Depth, Normal (and AO) of every frame to "
                              "DIR/####.exr with a top-level File Output node")
     return parser.parse_args(argv)
+
+
+def addon_compat():
+    return next(m for n, m in sys.modules.items() if n.endswith("ssao_compositor.compat"))
 
 
 def eevee_engine_name():
@@ -72,14 +82,17 @@ def main():
     layer.use_pass_z = True
     layer.use_pass_normal = True
     layer.use_pass_ambient_occlusion = args.ao_pass
-    render.image_settings.file_format = 'PNG' if args.output.endswith(".png") else 'OPEN_EXR'
-    if render.image_settings.file_format == 'OPEN_EXR':
-        render.image_settings.color_depth = '32'
-    render.image_settings.color_mode = 'RGBA'
+    compat = addon_compat()
+    file_format = args.format if args.format != "auto" else \
+        'PNG' if args.output.endswith(".png") else 'OPEN_EXR'
+    compat.set_image_format(render.image_settings, file_format, color_mode='RGBA',
+                            color_depth='8' if file_format == 'PNG' else '32')
     render.filepath = args.output
     render.use_file_extension = True
     # Linear output, so that tests can compare pixels with the passes.
     scene.view_settings.view_transform = 'Standard'
+    if args.compositor_device != "default":
+        render.compositor_device = args.compositor_device
     scene.frame_start, scene.frame_end = 1, args.frames
     if args.frames > 1:
         camera.location.x -= 0.2
@@ -87,33 +100,33 @@ def main():
         camera.location.x += 0.4
         camera.keyframe_insert("location", frame=args.frames)
 
-    scene.use_nodes = True
-    tree = scene.node_tree
+    tree = compat.ensure_compositor_tree(scene)
     tree.nodes.clear()
     rl = tree.nodes.new("CompositorNodeRLayers")
     ssao = tree.nodes.new("CompositorNodeSSAO")
     ssao.radius = args.radius
-    composite = tree.nodes.new("CompositorNodeComposite")
+    composite, composite_input = compat.add_result_output(tree)
     viewer = tree.nodes.new("CompositorNodeViewer")
     rl.location, ssao.location = (-300, 0), (0, 0)
     composite.location, viewer.location = (300, 100), (300, -150)
     tree.links.new(rl.outputs["Image"], ssao.inputs["Image"])
     tree.links.new(rl.outputs["Depth"], ssao.inputs["Depth"])
     tree.links.new(rl.outputs["Normal"], ssao.inputs["Normal"])
-    tree.links.new(ssao.outputs["Image"], composite.inputs["Image"])
+    tree.links.new(ssao.outputs["Image"], composite_input)
     tree.links.new(ssao.outputs["AO"], viewer.inputs["Image"])
     if args.passes_dir:
-        passes = tree.nodes.new("CompositorNodeOutputFile")
-        passes.location = (0, -300)
-        passes.base_path = os.path.abspath(args.passes_dir) + os.sep
-        passes.format.file_format = 'OPEN_EXR_MULTILAYER'
-        passes.format.color_depth = '32'
-        passes.file_slots.clear()
-        for name in ("Image", "Depth", "Normal") + (("AO",) if args.ao_pass else ()):
-            passes.file_slots.new(name)
-            tree.links.new(rl.outputs[name], passes.inputs[name])
+        slots = [("Image", 'RGBA'), ("Depth", 'FLOAT'), ("Normal", 'VECTOR')]
+        if args.ao_pass:
+            slots.append(("AO", 'RGBA'))
         # The node's own AO output: written again, with the computed AO, by the re-composite.
-        passes.file_slots.new("SSAO")
+        passes = compat.new_file_output(tree, slots + [("SSAO", 'FLOAT')])
+        passes.location = (0, -300)
+        compat.set_file_output_target(passes, os.path.abspath(args.passes_dir), "")
+        compat.set_image_format(passes.format, 'OPEN_EXR_MULTILAYER', color_depth='32')
+        for name, _ in slots:
+            # Cycles' AO pass is "AO" on Render Layers before 5.0, "Ambient Occlusion" after.
+            source = rl.outputs.get(name) or rl.outputs["Ambient Occlusion"]
+            tree.links.new(source, passes.inputs[name])
         tree.links.new(ssao.outputs["AO"], passes.inputs["SSAO"])
     out_prefix = os.path.splitext(os.path.abspath(args.out))[0]
     reference.write_json(out_prefix + ".camera.json", reference.camera_description(camera))

@@ -1,0 +1,261 @@
+# SPDX-License-Identifier: MIT
+"""When the AO is computed and applied: Blender's render, file and UI events.
+
+During a render the node's inner File Output writes the Depth and Normal it is fed (see
+inner_tree.py). Then:
+  - headless (blender -b ... -f/-a, scripts): render_post computes the AO, saves the Render
+    Result's passes and re-runs only the compositor (recomposite.py); render_write writes that
+    result over the frame's output file (a multilayer EXR gets every pass, the new Composite and
+    the AO);
+  - in the UI, handlers run in the render thread: render_write (an animation, Ctrl+F12) saves
+    each written frame's passes, render_post records the frame; when the render job is over, a
+    main-thread timer re-composites and rewrites every written frame with its own AO, then
+    computes the current frame's AO and nudges the UI compositor, which re-composites the
+    Render Result on screen.
+Changing a node property recomputes from the exported passes, without rendering.
+(Measured facts behind this design: docs/blender.md.)"""
+import atexit
+import os
+import re
+import shutil
+import time
+
+import bpy
+
+from . import compute, inner_tree, recomposite, saved_form
+from .compute import report
+
+_pending_frames = []    # UI: (scene name, frame) rendered, waiting for the main-thread timer
+_written_frames = []    # UI: (scene name, frame, output file, passes file) of an animation
+_recomposited = {}      # headless: (scene name, frame) -> (passes file, AO layers)
+_render_started = 0.0   # time.time() of the last render's start: older exports are stale
+
+
+def ao_layers(aos):
+    """Multilayer names of the nodes' AO: SSAO.AO for one node, SSAO.<node name> for more."""
+    if len(aos) == 1:
+        return {"SSAO.AO": next(iter(aos.values()))}
+    return {"SSAO." + re.sub(r"[.\s]+", "_", name): ao for name, ao in aos.items()}
+
+
+def _written_output(scene):
+    """The file Blender just wrote for this frame: the frame path (-f, -a) or, for a still
+    written from a script (render(write_still=True)), the output path without frame number."""
+    render = scene.render
+    still = bpy.path.abspath(render.filepath)
+    if render.use_file_extension and not still.lower().endswith(render.file_extension.lower()):
+        still += render.file_extension
+    candidates = [p for p in (render.frame_path(frame=scene.frame_current), still)
+                  if os.path.isfile(p)]
+    return max(candidates, key=os.path.getmtime) if candidates else None
+
+
+def _recomposite_and_write(scene, frame, output, passes, layers):
+    helper = recomposite.recomposite(scene, passes)
+    recomposite.write_output(scene, helper, output, passes, layers)
+    report(f"wrote {output} with AO")
+
+
+def _remove(path):
+    try:
+        os.remove(path)
+    except OSError:
+        pass
+
+
+@bpy.app.handlers.persistent
+def _on_render_pre(scene, *_):
+    """A file loaded before the add-on registered (5.x: `blender -b file --addons ...` registers
+    with bpy.data out of reach) still carries its nodes as group nodes: turn them back now."""
+    global _render_started
+    if recomposite.is_running():
+        return
+    if bpy.app.background or not _written_frames:  # (the UI: the animation's first frame)
+        _render_started = time.time() - 1.0  # file times may be rounded to the second
+    if saved_form.from_group_nodes():
+        for _, node in compute.all_ssao_nodes():
+            compute.configure_node(node)
+
+
+@bpy.app.handlers.persistent
+def _on_render_post(scene, *_):
+    if recomposite.is_running() or not compute.ssao_nodes(scene):
+        return
+    if not bpy.app.background:
+        _pending_frames.append((scene.name, scene.frame_current))
+        if not bpy.app.timers.is_registered(_process_pending):
+            bpy.app.timers.register(_process_pending, first_interval=0.1)
+        return
+    frame = scene.frame_current
+    aos = compute.compute_frame(scene, frame, _render_started)
+    if not aos:
+        return
+    passes = recomposite.passes_path(scene, frame)
+    try:
+        recomposite.save_passes(scene, passes)
+        recomposite.recomposite(scene, passes)
+        _recomposited[(scene.name, frame)] = (passes, ao_layers(aos))
+    except Exception as error:
+        report(f"re-compositing frame {frame} failed: {error}", error=True)
+        _remove(passes)
+
+
+@bpy.app.handlers.persistent
+def _on_render_write(scene, *_):
+    """A frame file was written, with the AO of before this frame: write it again."""
+    if recomposite.is_running():
+        return
+    frame = scene.frame_current
+    if not bpy.app.background:
+        # An animation in the UI: the Render Result holds this frame's passes only until the
+        # next frame renders, so save them now (render thread) and finish after the job.
+        if compute.ssao_nodes(scene):
+            output = _written_output(scene)
+            passes = recomposite.passes_path(scene, frame)
+            try:
+                recomposite.save_passes(scene, passes)
+                _written_frames.append((scene.name, frame, output, passes))
+            except Exception as error:
+                report(f"frame {frame}: saving the passes failed, the file keeps the AO of "
+                       f"before: {error}", error=True)
+        return
+    entry = _recomposited.pop((scene.name, frame), None)
+    if entry is None:
+        return
+    passes, layers = entry
+    try:
+        output = _written_output(scene)
+        if output is None:
+            report("cannot find the file this render wrote; it keeps the composite without AO",
+                   error=True)
+            return
+        # The helper's Render Result holds the re-composited frame.
+        helper = recomposite.helper_scene_if_any(scene)
+        recomposite.write_output(scene, helper, output, passes, layers)
+        report(f"wrote {output} with AO")
+    except Exception as error:
+        report(f"writing frame {frame} with AO failed: {error}", error=True)
+    finally:
+        _remove(passes)
+
+
+def _process_pending():
+    """UI: main-thread work after a render (handlers run in the render thread there)."""
+    if bpy.app.is_job_running('RENDER'):
+        return 0.2
+    while _written_frames:
+        scene_name, frame, output, passes = _written_frames.pop(0)
+        scene = bpy.data.scenes.get(scene_name)
+        if scene is None or output is None:
+            _remove(passes)
+            continue
+        # The camera (and the re-composite's frame) of that frame, not of the current one.
+        current = scene.frame_current
+        try:
+            scene.frame_set(frame)
+            aos = compute.compute_frame(scene, frame, _render_started)
+            if aos:
+                _recomposite_and_write(scene, frame, output, passes, ao_layers(aos))
+        except Exception as error:
+            report(f"frame {frame}: writing it with AO failed: {error}", error=True)
+        finally:
+            scene.frame_set(current)
+            _remove(passes)
+    current = _pending_frames[-1] if _pending_frames else None
+    _pending_frames.clear()
+    scene = bpy.data.scenes.get(current[0]) if current else None
+    if scene is not None and compute.compute_frame(scene, current[1], _render_started):
+        for node in compute.ssao_nodes(scene):
+            inner_tree.nudge(node)
+        if not _compositor_editor_open():
+            message = ("AO computed; open a compositor Node Editor (and an Image Editor "
+                       "showing Render Result) to see it applied")
+            for node in compute.ssao_nodes(scene):
+                node.status = message
+            report(message)
+    return None
+
+
+def _compositor_editor_open():
+    """Blender re-composites the Render Result only from a visible compositor Node Editor."""
+    for window in bpy.context.window_manager.windows:
+        for area in window.screen.areas:
+            for space in area.spaces:
+                if space.type == 'NODE_EDITOR' and space.tree_type == "CompositorNodeTree":
+                    return True
+    return False
+
+
+def parameter_changed(node, scene):
+    """A node property changed: recompute from the last export, then re-composite (UI)."""
+    if recomposite.is_running() or saved_form.is_restoring() or bpy.app.background or \
+            scene is None:
+        return
+    path = inner_tree.export_path(node, scene.frame_current)
+    if not os.path.exists(path):
+        node.status = "Render (F12) to compute the AO"
+        return
+    try:
+        compute.compute_node(node, scene, compute.read_export(path))
+        node.status = f"Frame {scene.frame_current}: recomputed"
+        inner_tree.nudge(node)
+    except Exception as error:
+        node.status = f"Error: {error}"
+        report(str(error), error=True)
+
+
+@bpy.app.handlers.persistent
+def _on_load_post(*_):
+    saved_form.from_group_nodes()
+    for _, node in compute.all_ssao_nodes():
+        compute.configure_node(node)
+
+
+@bpy.app.handlers.persistent
+def _on_save_pre(*_):
+    # The AO must travel inside the .blend; exporters point at a folder every session has, so
+    # that a file opened without the add-on (or before it is enabled) writes somewhere harmless
+    # and, with the add-on, where it will look.
+    recomposite.remove_helpers()
+    for _, node in compute.all_ssao_nodes():
+        image = inner_tree.inner(node, inner_tree.AO_NODE).image
+        # Pack what is in memory; packing an unchanged packed image again would re-read a file
+        # that does not exist and drop the pixels.
+        if image is not None and image.has_data and (image.is_dirty or not image.packed_file):
+            image.pack()
+        inner_tree.point_exporter(node, compute.SAVED_EXPORT_DIR)
+    saved_form.to_group_nodes()
+
+
+@bpy.app.handlers.persistent
+def _on_save_post(*_):
+    saved_form.from_group_nodes()
+    for _, node in compute.all_ssao_nodes():
+        inner_tree.point_exporter(node, compute.export_dir())
+
+
+_HANDLERS = (("render_pre", _on_render_pre), ("render_post", _on_render_post), ("render_write", _on_render_write),
+             ("load_post", _on_load_post), ("save_pre", _on_save_pre),
+             ("save_post", _on_save_post))
+
+
+def register():
+    for name, handler in _HANDLERS:
+        getattr(bpy.app.handlers, name).append(handler)
+    if compute.export_dir() == compute.PROCESS_EXPORT_DIR:
+        # This session's exports are of no use to any other: remove them when Blender quits.
+        atexit.register(shutil.rmtree, compute.PROCESS_EXPORT_DIR, ignore_errors=True)
+    # Nodes of a file that is already open (enabling the add-on after loading).
+    try:
+        saved_form.from_group_nodes()
+        for _, node in compute.all_ssao_nodes():
+            compute.configure_node(node)
+    except AttributeError:  # bpy.data is restricted while add-ons register at start-up
+        pass
+
+
+def unregister():
+    for name, handler in _HANDLERS:
+        handlers = getattr(bpy.app.handlers, name)
+        if handler in handlers:
+            handlers.remove(handler)

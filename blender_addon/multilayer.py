@@ -1,0 +1,234 @@
+# SPDX-License-Identifier: MIT
+"""Reading the scanline OpenEXR files Blender writes for multilayer output (channels named
+layer.pass.channel; single-part before 5.x, one part per layer in 5.x) with no compression or
+ZIP/ZIPS, and writing them single-part: enough to put
+the re-composited image and the AO into a render's multilayer file. Blender's Python has no
+EXR writer that takes arbitrary channels, so this one is pure numpy + zlib (no bpy: tested
+from plain Python against OpenImageIO in tests/python/test_multilayer.py).
+
+Format: OpenEXR file layout, openexr.com "OpenEXR File Layout" (magic, version, header
+attributes, offset table, chunks; ZIP = byte interleave + delta predictor + zlib)."""
+import os
+import struct
+import zlib
+
+import numpy as np
+
+MAGIC = 20000630
+NO_COMPRESSION, ZIPS_COMPRESSION, ZIP_COMPRESSION = 0, 2, 3
+LINES_PER_CHUNK = {NO_COMPRESSION: 1, ZIPS_COMPRESSION: 1, ZIP_COMPRESSION: 16}
+HALF, FLOAT = 1, 2
+CODECS = {"NONE": NO_COMPRESSION, "ZIPS": ZIPS_COMPRESSION, "ZIP": ZIP_COMPRESSION}
+# Written again from the channels; any other attribute of the source is copied as it is.
+_REWRITTEN = {"channels", "compression", "dataWindow", "displayWindow", "lineOrder", "chunkCount"}
+_DTYPES = {HALF: np.dtype("<f2"), FLOAT: np.dtype("<f4")}
+
+
+class ExrError(RuntimeError):
+    pass
+
+
+def _cstring(data, at):
+    end = data.index(b"\0", at)
+    return data[at:end].decode("utf-8", "replace"), end + 1
+
+
+def _read_headers(data):
+    """[(attributes, ...)] of each part, the offset where the offset tables start, multi-part."""
+    if len(data) < 8 or struct.unpack_from("<i", data, 0)[0] != MAGIC:
+        raise ExrError("not an OpenEXR file")
+    version = struct.unpack_from("<I", data, 4)[0]
+    if version & 0x200:
+        raise ExrError("tiled OpenEXR files are not supported")
+    if version & 0x800:
+        raise ExrError("deep OpenEXR files are not supported")
+    multipart = bool(version & 0x1000)
+    at, headers, attributes = 8, [], {}
+    while True:
+        if at >= len(data):
+            raise ExrError("truncated header")
+        if data[at] == 0:
+            at += 1
+            if not multipart:
+                return [attributes], at, False
+            if not attributes:  # the empty header that ends a multi-part file's list
+                return headers, at, True
+            headers.append(attributes)
+            attributes = {}
+            continue
+        name, at = _cstring(data, at)
+        kind, at = _cstring(data, at)
+        size = struct.unpack_from("<i", data, at)[0]
+        at += 4
+        if size < 0 or at + size > len(data):
+            raise ExrError(f"truncated attribute {name}")
+        attributes[name] = (kind, data[at:at + size])
+        at += size
+
+
+def _channels(raw):
+    out, at = [], 0
+    while raw[at] != 0:
+        name, at = _cstring(raw, at)
+        pixel_type = struct.unpack_from("<i", raw, at)[0]
+        x_sampling, y_sampling = struct.unpack_from("<ii", raw, at + 8)
+        if pixel_type not in _DTYPES or (x_sampling, y_sampling) != (1, 1):
+            raise ExrError(f"channel {name}: only unsubsampled half and float are supported")
+        out.append((name, pixel_type))
+        at += 16
+    return out
+
+
+def _unzip(block, expected):
+    raw = np.frombuffer(zlib.decompress(block), np.uint8)
+    if raw.size != expected:
+        raise ExrError("corrupt ZIP chunk")
+    # Undo the predictor (running sum of deltas - 128, mod 256), then the interleave.
+    values = ((np.cumsum(raw.astype(np.int64)) - 128 * np.arange(raw.size)) % 256).astype(np.uint8)
+    half = (raw.size + 1) // 2
+    out = np.empty(raw.size, np.uint8)
+    out[0::2], out[1::2] = values[:half], values[half:]
+    return out.tobytes()
+
+
+def _zip(data):
+    raw = np.frombuffer(data, np.uint8)
+    interleaved = np.concatenate([raw[0::2], raw[1::2]])
+    deltas = np.empty_like(interleaved)
+    deltas[0] = interleaved[0]
+    deltas[1:] = (interleaved[1:].astype(np.int16) - interleaved[:-1] + 128 + 256) % 256
+    return zlib.compress(deltas.tobytes(), 6)
+
+
+def _read_part(data, path, attributes, offsets, multipart, planes):
+    for name in ("channels", "compression", "dataWindow"):
+        if name not in attributes:
+            raise ExrError(f"{path}: the header has no {name}")
+    if attributes.get("type", ("", b"scanlineimage"))[1].rstrip(b"\0") != b"scanlineimage":
+        raise ExrError(f"{path}: only scanline images are supported")
+    channels = _channels(attributes["channels"][1])
+    compression = attributes["compression"][1][0]
+    if compression not in LINES_PER_CHUNK:
+        raise ExrError(f"{path}: compression {compression} is not supported (NONE, ZIP, ZIPS)")
+    x0, y0, x1, y1 = struct.unpack("<4i", attributes["dataWindow"][1])
+    width, height = x1 - x0 + 1, y1 - y0 + 1
+    lines = LINES_PER_CHUNK[compression]
+    line_bytes = sum(width * _DTYPES[t].itemsize for _, t in channels)
+    for name, _ in channels:
+        planes[name] = np.empty((height, width), np.float32)
+    skip = 4 if multipart else 0  # a multi-part file's chunks start with their part number
+    for offset in offsets:
+        if offset + skip + 8 > len(data):
+            raise ExrError(f"{path}: truncated")
+        y, size = struct.unpack_from("<ii", data, offset + skip)
+        block = data[offset + skip + 8:offset + skip + 8 + size]
+        row0 = y - y0
+        count = min(lines, height - row0)
+        if len(block) != size or row0 < 0 or count <= 0:
+            raise ExrError(f"{path}: truncated or corrupt chunk")
+        if size < count * line_bytes:
+            block = _unzip(block, count * line_bytes)
+        at_block = 0
+        for row in range(row0, row0 + count):
+            for name, pixel_type in channels:
+                dtype = _DTYPES[pixel_type]
+                planes[name][row] = np.frombuffer(block, dtype, width, at_block)
+                at_block += width * dtype.itemsize
+
+
+def read(path):
+    """{channel name: (height, width) float32 array, row 0 on top} of every part, and the
+    first part's attributes."""
+    with open(path, "rb") as f:
+        data = f.read()
+    try:
+        return _read(data, path)
+    except (struct.error, zlib.error, ValueError, IndexError, KeyError) as error:
+        raise ExrError(f"{path}: corrupt or truncated ({error})") from None
+
+
+def _read(data, path):
+    headers, at, multipart = _read_headers(data)
+    planes = {}
+    for attributes in headers:
+        if "dataWindow" not in attributes or "compression" not in attributes:
+            raise ExrError(f"{path}: the header has no dataWindow or compression")
+        x0, y0, x1, y1 = struct.unpack("<4i", attributes["dataWindow"][1])
+        lines = LINES_PER_CHUNK.get(attributes["compression"][1][0], 1)
+        chunks = (y1 - y0 + lines) // lines
+        if at + 8 * chunks > len(data):
+            raise ExrError(f"{path}: truncated offset table")
+        offsets = struct.unpack_from(f"<{chunks}Q", data, at)
+        at += 8 * chunks
+        _read_part(data, path, attributes, offsets, multipart, planes)
+    first = {k: v for k, v in headers[0].items() if k not in ("name", "type")}
+    return planes, first
+
+
+def _attribute(name, kind, value):
+    return name.encode() + b"\0" + kind.encode() + b"\0" + struct.pack("<i", len(value)) + value
+
+
+def write(path, planes, attributes=None, half=False, codec="ZIP"):
+    """Writes {channel name: (height, width) array, row 0 on top} as a single-part scanline
+    EXR; `attributes` (as read() returns them) are copied but for the ones written anew. half:
+    16-bit channels (depth, named Z, stays 32-bit as Blender keeps it)."""
+    compression = CODECS.get(codec, ZIP_COMPRESSION)
+    names = sorted(planes)
+    height, width = planes[names[0]].shape
+    types = {n: FLOAT if not half or n.endswith(".Z") or n == "Z" else HALF for n in names}
+    chlist = b"".join(n.encode() + b"\0" + struct.pack("<iB3xii", types[n], 0, 1, 1)
+                      for n in names) + b"\0"
+    window = struct.pack("<4i", 0, 0, width - 1, height - 1)
+    header = [_attribute("channels", "chlist", chlist),
+              _attribute("compression", "compression", bytes([compression])),
+              _attribute("dataWindow", "box2i", window),
+              _attribute("displayWindow", "box2i", window),
+              _attribute("lineOrder", "lineOrder", b"\0")]
+    defaults = {"pixelAspectRatio": ("float", struct.pack("<f", 1.0)),
+                "screenWindowCenter": ("v2f", struct.pack("<2f", 0.0, 0.0)),
+                "screenWindowWidth": ("float", struct.pack("<f", 1.0))}
+    for name, (kind, value) in {**defaults, **(attributes or {})}.items():
+        if name not in _REWRITTEN:
+            header.append(_attribute(name, kind, value))
+    long_names = any(len(n) > 31 for n in names) or \
+        any(len(n) > 31 for n in (attributes or {}))
+    head = struct.pack("<iI", MAGIC, 2 | (0x400 if long_names else 0)) + b"".join(header) + b"\0"
+
+    lines = LINES_PER_CHUNK[compression]
+    columns = [np.ascontiguousarray(planes[n], dtype=_DTYPES[types[n]]) for n in names]
+    chunks = []
+    for row0 in range(0, height, lines):
+        rows = range(row0, min(row0 + lines, height))
+        block = b"".join(column[row].tobytes() for row in rows for column in columns)
+        if compression != NO_COMPRESSION:
+            packed = _zip(block)
+            if len(packed) < len(block):
+                block = packed
+        chunks.append(struct.pack("<ii", row0, len(block)) + block)
+    offset = len(head) + 8 * len(chunks)
+    table = []
+    for chunk in chunks:
+        table.append(offset)
+        offset += len(chunk)
+    temporary = path + ".part"
+    with open(temporary, "wb") as f:
+        f.write(head)
+        f.write(struct.pack(f"<{len(table)}Q", *table))
+        for chunk in chunks:
+            f.write(chunk)
+    os.replace(temporary, path)
+
+
+def rewrite(passes_path, composite_path, ao_layers, out_path, half=False, codec="ZIP"):
+    """The render's multilayer file, written anew: every pass of `passes_path`, its Composite
+    layer replaced by the RGBA of `composite_path`, and `ao_layers` ({layer.pass name: (height,
+    width) AO}) added as one-channel passes (channel V)."""
+    planes, attributes = read(passes_path)
+    composite, _ = read(composite_path)
+    for channel in "RGBA":
+        if channel in composite:
+            planes[f"Composite.Combined.{channel}"] = composite[channel]
+    for name, ao in ao_layers.items():
+        planes[f"{name}.V"] = ao
+    write(out_path, planes, attributes, half=half, codec=codec)

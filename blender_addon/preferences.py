@@ -1,0 +1,44 @@
+# SPDX-License-Identifier: MIT
+"""The add-on's preferences: where the passes are exported, and what the library says."""
+import bpy
+
+from . import compute
+
+
+def _on_export_dir_changed(preferences, context):
+    compute.preferred_export_dir = bpy.path.abspath(preferences.export_dir)
+    for _, node in compute.all_ssao_nodes():
+        compute.configure_node(node)
+
+
+class SSAOPreferences(bpy.types.AddonPreferences):
+    bl_idname = __package__
+
+    export_dir: bpy.props.StringProperty(
+        name="Keep passes in", subtype='DIR_PATH', update=_on_export_dir_changed,
+        description="Folder where the node exports the Depth and Normal it is fed (one 32-bit "
+                    "EXR per node and frame), kept for the command-line tool; empty: a "
+                    "temporary folder removed when Blender quits "
+                    "($SSAO_COMPOSITOR_EXPORT_DIR overrides both)")
+
+    def draw(self, context):
+        layout = self.layout
+        layout.prop(self, "export_dir")
+        try:
+            library = compute.library()
+            version = library.ssao_version()
+            layout.label(text=f"libssao {version // 10000}.{version // 100 % 100}."
+                              f"{version % 100}: {library._name}", icon='CHECKMARK')
+        except Exception as error:
+            layout.label(text=f"libssao: {error}", icon='ERROR')
+
+
+def register():
+    bpy.utils.register_class(SSAOPreferences)
+    addon = bpy.context.preferences.addons.get(__package__)
+    if addon is not None and addon.preferences is not None:
+        compute.preferred_export_dir = bpy.path.abspath(addon.preferences.export_dir)
+
+
+def unregister():
+    bpy.utils.unregister_class(SSAOPreferences)

@@ -1,0 +1,127 @@
+#!/usr/bin/python3
+# SPDX-License-Identifier: MIT
+"""The Blender add-on's EXR reader/writer (blender_addon/multilayer.py) against OpenImageIO:
+what one writes the other reads back, for every codec and depth, single- and multi-part, and
+hostile files are refused with a message."""
+import os
+import shutil
+import sys
+import tempfile
+import unittest
+
+import numpy as np
+import OpenImageIO as oiio
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path.insert(0, os.path.join(HERE, "..", "..", "blender_addon"))
+sys.path.insert(0, os.path.join(HERE, ".."))
+import multilayer  # noqa: E402
+from image_files import read_image  # noqa: E402
+
+
+def sample_planes(height=37, width=53):
+    rng = np.random.default_rng(7)
+    planes = {f"ViewLayer.Combined.{c}": rng.random((height, width), np.float32) for c in "RGBA"}
+    planes["ViewLayer.Depth.Z"] = rng.random((height, width), np.float32) * 1000
+    planes["ViewLayer.Normal.X"] = rng.standard_normal((height, width)).astype(np.float32)
+    return planes
+
+
+def _with_bad_offsets(data):
+    """The file with its first chunk offset pointing past the end."""
+    header_end = data.index(b"\0\0", data.index(b"screenWindowWidth")) + 2
+    return data[:header_end - 1] + (2 ** 40).to_bytes(8, "little") + data[header_end + 7:]
+
+
+class MultilayerTest(unittest.TestCase):
+    def setUp(self):
+        self.folder = tempfile.mkdtemp(prefix="ssao_multilayer_")
+        self.planes = sample_planes()
+
+    def tearDown(self):
+        shutil.rmtree(self.folder, ignore_errors=True)
+
+    def path(self, name):
+        return os.path.join(self.folder, name)
+
+    def test_written_files_read_back_in_openimageio(self):
+        for codec in ("NONE", "ZIPS", "ZIP"):
+            for half in (False, True):
+                with self.subTest(codec=codec, half=half):
+                    path = self.path(f"{codec}_{half}.exr")
+                    multilayer.write(path, self.planes, half=half, codec=codec)
+                    names, pixels = read_image(path)
+                    self.assertEqual(sorted(names), sorted(self.planes))
+                    for name, plane in self.planes.items():
+                        # half: 11-bit mantissa; depth (Z) stays 32-bit.
+                        tolerance = 0 if not half or name.endswith(".Z") else \
+                            float(np.abs(plane).max()) * 2 ** -10
+                        np.testing.assert_allclose(pixels[:, :, names.index(name)], plane,
+                                                   rtol=0, atol=tolerance)
+                    spec = oiio.ImageInput.open(path).spec()
+                    self.assertEqual(spec.get_string_attribute("compression"), codec.lower())
+
+    def test_reads_single_and_multi_part_files_openimageio_wrote(self):
+        names = sorted(self.planes)
+        height, width = self.planes[names[0]].shape
+        # One part per layer, as Blender 5.x writes multilayer files.
+        layers = {}
+        for name in names:
+            layers.setdefault(name.rsplit(".", 1)[0], []).append(name)
+        specs = []
+        for layer, channels in layers.items():
+            spec = oiio.ImageSpec(width, height, len(channels), oiio.FLOAT)
+            spec.channelnames = tuple(channels)
+            spec.attribute("name", layer)
+            spec.attribute("compression", "zip")
+            specs.append(spec)
+        path = self.path("multipart.exr")
+        out = oiio.ImageOutput.create(path)
+        self.assertTrue(out.open(path, specs), out.geterror())
+        for i, (layer, channels) in enumerate(layers.items()):
+            if i:
+                self.assertTrue(out.open(path, specs[i], "AppendSubimage"), out.geterror())
+            out.write_image(np.stack([self.planes[c] for c in channels], axis=-1))
+        out.close()
+        planes, _ = multilayer.read(path)
+        self.assertEqual(sorted(planes), names)
+        for name in names:
+            np.testing.assert_array_equal(planes[name], self.planes[name])
+
+    def test_rewrite_replaces_the_composite_and_adds_the_ao(self):
+        passes = dict(self.planes)
+        passes.update({f"Composite.Combined.{c}": np.zeros_like(passes["ViewLayer.Depth.Z"])
+                       for c in "RGBA"})
+        multilayer.write(self.path("passes.exr"), passes, codec="ZIP")
+        composite = {c: np.full_like(passes["ViewLayer.Depth.Z"], 0.25 * (i + 1))
+                     for i, c in enumerate("RGBA")}
+        multilayer.write(self.path("composite.exr"), composite, codec="NONE")
+        ao = np.linspace(0, 1, passes["ViewLayer.Depth.Z"].size, dtype=np.float32).reshape(
+            passes["ViewLayer.Depth.Z"].shape)
+        multilayer.rewrite(self.path("passes.exr"), self.path("composite.exr"),
+                           {"SSAO.AO": ao}, self.path("out.exr"))
+        names, pixels = read_image(self.path("out.exr"))
+        for i, c in enumerate("RGBA"):
+            np.testing.assert_array_equal(pixels[:, :, names.index(f"Composite.Combined.{c}")],
+                                          0.25 * (i + 1))
+        np.testing.assert_array_equal(pixels[:, :, names.index("SSAO.AO.V")], ao)
+        np.testing.assert_array_equal(pixels[:, :, names.index("ViewLayer.Depth.Z")],
+                                      self.planes["ViewLayer.Depth.Z"])
+
+    def test_hostile_files_are_refused_with_a_message(self):
+        multilayer.write(self.path("good.exr"), self.planes, codec="ZIP")
+        with open(self.path("good.exr"), "rb") as f:
+            data = f.read()
+        cases = {"empty": b"", "not_exr": b"P6\n1 1\n255\n\0\0\0",
+                 "truncated_header": data[:40], "truncated_data": data[:len(data) // 2],
+                 "bad_offsets": _with_bad_offsets(data)}
+        for name, content in cases.items():
+            with self.subTest(name):
+                with open(self.path(name), "wb") as f:
+                    f.write(content)
+                with self.assertRaises(multilayer.ExrError):
+                    multilayer.read(self.path(name))
+
+
+if __name__ == "__main__":
+    unittest.main(verbosity=2)
