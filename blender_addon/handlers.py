@@ -143,6 +143,10 @@ def _process_pending():
     """UI: main-thread work after a render (handlers run in the render thread there)."""
     if bpy.app.is_job_running('RENDER'):
         return 0.2
+    if _written_frames:
+        # Outside a render handler the helper scene can go: the next one copies the compositor
+        # as it is now (before 5.0 a scene's tree cannot be swapped, only copied with it).
+        recomposite.remove_helpers()
     while _written_frames:
         scene_name, frame, output, passes = _written_frames.pop(0)
         scene = bpy.data.scenes.get(scene_name)

@@ -125,6 +125,41 @@ std::string join_names(const std::vector<std::string>& names, const char* separa
   return out;
 }
 
+namespace {
+
+// A multi-part EXR (Blender 5.x writes a multilayer file as one part per layer) reads as one
+// image with the channels of every part, in file order. Parts of another size are refused.
+void append_exr_parts(OIIO::ImageInput& input, const std::string& path, Image& image) {
+  for (int part = 1; input.seek_subimage(part, 0); ++part) {
+    const OIIO::ImageSpec spec = input.spec();
+    if (spec.width != image.width || spec.height != image.height || spec.x != 0 || spec.y != 0 ||
+        spec.deep || spec.depth > 1) {
+      throw Error("cannot read " + quoted(path) + ": its part " + std::to_string(part) + " (" +
+                  std::string(spec.get_string_attribute("name")) +
+                  ") is not the size of the first");
+    }
+    const int old_channels = image.channels();
+    const int channels = old_channels + spec.nchannels;
+    const size_t pixels = image.pixel_count();
+    std::vector<float> part_pixels(
+        checked_float_count(spec.width, spec.height, spec.nchannels, path));
+    if (!input.read_image(part, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, part_pixels.data())) {
+      throw Error("cannot read " + quoted(path) + ": the file is truncated or corrupt (" +
+                  oiio_detail(input.geterror()) + ")");
+    }
+    std::vector<float> merged(checked_float_count(image.width, image.height, channels, path));
+    for (size_t i = 0; i < pixels; ++i) {
+      std::copy_n(&image.pixels[i * old_channels], old_channels, &merged[i * channels]);
+      std::copy_n(&part_pixels[i * spec.nchannels], spec.nchannels,
+                  &merged[i * channels + old_channels]);
+    }
+    image.pixels.swap(merged);
+    for (int c = 0; c < spec.nchannels; ++c) image.channel_names.push_back(spec.channel_name(c));
+  }
+}
+
+}  // namespace
+
 Image read_image(const std::string& path) {
   require_readable_file(path);
   auto input = OIIO::ImageInput::open(path);
@@ -160,12 +195,12 @@ Image read_image(const std::string& path) {
   }
   const bool ok =
       input->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, image.pixels.data());
-  const std::string error = input->geterror();
-  input->close();
   if (!ok) {
     throw Error("cannot read " + quoted(path) + ": the file is truncated or corrupt (" +
-                oiio_detail(error) + ")");
+                oiio_detail(input->geterror()) + ")");
   }
+  if (std::string(input->format_name()) == "openexr") append_exr_parts(*input, path, image);
+  input->close();
   return image;
 }
 

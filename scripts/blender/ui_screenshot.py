@@ -121,7 +121,7 @@ def window_region(area):
 
 
 def ssao_node(scene):
-    tree = scene.node_tree
+    tree = addon_module("compat").compositor_tree(scene)  # scene.node_tree before 5.0
     nodes = [n for n in tree.nodes if n.bl_idname == NODE_IDNAME] if tree else []
     if not nodes:
         raise RuntimeError(f"scene '{scene.name}' has no {NODE_IDNAME} in its compositor")
@@ -240,16 +240,17 @@ def screenshot_x_root(path):
     log(f"saved {path}" if result.returncode == 0 else f"import failed: {result.stderr}")
 
 
-def addon_pipeline():
-    """The enabled add-on's pipeline module (legacy or extension name)."""
-    return next(m for n, m in sys.modules.items() if n.endswith("ssao_compositor.pipeline"))
+def addon_module(name):
+    """A module of the enabled add-on, whatever its package is called (ssao_compositor as a
+    legacy add-on in 3.x, bl_ext.<repository>.ssao_compositor as an extension in 4.2+)."""
+    return next(m for n, m in sys.modules.items() if n.endswith("ssao_compositor." + name))
 
 
 # --- checking the Render Result --------------------------------------------------------------
 
 def save_render_result(scene, path):
     """The Render Result as a 32-bit multilayer EXR (all passes and the Composite layer)."""
-    addon_pipeline().save_passes(scene, path)
+    addon_module("recomposite").save_passes(scene, path)
 
 
 def node_ao(node):

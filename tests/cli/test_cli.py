@@ -289,6 +289,34 @@ class GoodRunTest(CliTestCase):
         self.assert_ok(self.run_ssao("--depth-channel", "Z", "--normal-channels", "N.X,N.Y,N.Z",
                                      "--beauty-channels", "B,G,R"))
 
+    def test_multi_part_exr_as_blender_5_writes_it(self):
+        # Blender 5.x writes a multilayer EXR as one part per layer: the same result as the
+        # single-part file.
+        self.assert_ok(self.run_ssao("--ao-only"))
+        _, single = read_image(self.output)
+        layers = {}
+        for name in BLENDER_CHANNELS:
+            layers.setdefault(name.rsplit(".", 1)[0], []).append(name)
+        specs = []
+        for layer, names in layers.items():
+            spec = oiio.ImageSpec(WIDTH, HEIGHT, len(names), oiio.FLOAT)
+            spec.channelnames = tuple(names)
+            spec.attribute("name", layer)
+            specs.append(spec)
+        multipart = self.path("multipart.exr")
+        out = oiio.ImageOutput.create(multipart)
+        self.assertTrue(out.open(multipart, specs), out.geterror())
+        for i, names in enumerate(layers.values()):
+            if i:
+                self.assertTrue(out.open(multipart, specs[i], "AppendSubimage"), out.geterror())
+            out.write_image(np.stack([self.planes[n] for n in names], axis=-1))
+        out.close()
+        os.remove(self.output)
+        self.assert_ok(self.run_ssao(multipart, "-o", self.output, "--camera", self.camera,
+                                     "--radius", RADIUS, "--ao-only", default_paths=False))
+        _, parts = read_image(self.output)
+        np.testing.assert_array_equal(parts, single)
+
     def test_layer_choice(self):
         planes = dict(self.planes)
         for name in BLENDER_CHANNELS:
