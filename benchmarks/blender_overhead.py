@@ -101,7 +101,8 @@ def inner_main(argv):
     args = parser.parse_args(argv)
 
     scene = bpy.context.scene
-    tree = scene.node_tree
+    compat = next(m for n, m in sys.modules.items() if n.endswith("ssao_compositor.compat"))
+    tree = compat.compositor_tree(scene)  # scene.node_tree before 5.0, a node group after
     nodes = [n for n in tree.nodes if n.bl_idname == NODE_IDNAME] if tree else []
     if not nodes:
         raise SystemExit(f"blender_overhead: scene '{scene.name}' has no {NODE_IDNAME}")

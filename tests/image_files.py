@@ -22,3 +22,26 @@ def read_image(path):
         part += 1
     inp.close()
     return names, np.concatenate(planes, axis=2)
+
+
+def write_multipart_exr(path, planes):
+    """Writes {layer.pass.channel: (height, width) array} as a multi-part EXR, one part per
+    layer.pass, as Blender 5.x writes multilayer files."""
+    parts = {}
+    for name in planes:
+        parts.setdefault(name.rsplit(".", 1)[0], []).append(name)
+    height, width = next(iter(planes.values())).shape
+    specs = []
+    for part, names in parts.items():
+        spec = oiio.ImageSpec(width, height, len(names), oiio.FLOAT)
+        spec.channelnames = tuple(names)
+        spec.attribute("name", part)
+        spec.attribute("compression", "zip")
+        specs.append(spec)
+    out = oiio.ImageOutput.create(path)
+    assert out is not None and out.open(path, specs), oiio.geterror()
+    for i, names in enumerate(parts.values()):
+        if i:
+            assert out.open(path, specs[i], "AppendSubimage"), out.geterror()
+        assert out.write_image(np.stack([planes[n] for n in names], axis=-1).astype(np.float32))
+    out.close()

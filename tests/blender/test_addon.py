@@ -13,6 +13,7 @@ import argparse
 import glob
 import json
 import os
+import re
 import shlex
 import shutil
 import subprocess
@@ -140,6 +141,13 @@ class AddonTest(unittest.TestCase):
         np.testing.assert_allclose(out["A"], passes["Image.A"], atol=1e-6)
         return ao, passes
 
+    def assert_frames_are_beauty_times_ao(self, folder, frames):
+        """Frames 1..frames of folder/out_####.exr against folder/passes/; returns their AO."""
+        return [self.assert_composite_is_beauty_times_ao(
+                    os.path.join(folder, f"out_{frame:04d}.exr"),
+                    os.path.join(folder, "passes", f"{frame:04d}.exr"))[0]
+                for frame in range(1, frames + 1)]
+
     def cli_ao(self, folder, camera_json, frame=1):
         export = glob.glob(os.path.join(folder, "export", f"ssao_*{frame:04d}.exr"))
         self.assertEqual(len(export), 1, export)
@@ -199,12 +207,7 @@ class AddonTest(unittest.TestCase):
         log = self.blender.run(blend, "-a", env={
             "SSAO_COMPOSITOR_EXPORT_DIR": os.path.join(folder, "export")})
         self.assertEqual(log.count("with AO"), 3, log)
-        aos = []
-        for frame in (1, 2, 3):
-            ao, _ = self.assert_composite_is_beauty_times_ao(
-                os.path.join(folder, f"out_{frame:04d}.exr"),
-                os.path.join(folder, "passes", f"{frame:04d}.exr"))
-            aos.append(ao)
+        aos = self.assert_frames_are_beauty_times_ao(folder, 3)
         self.assertGreater(float(np.abs(aos[0] - aos[2]).max()), 0.1, "the camera moves")
 
     def test_multilayer_output_holds_the_composite_with_ao(self):
@@ -267,12 +270,7 @@ class AddonTest(unittest.TestCase):
         log = self.blender.run_ui(blend, os.path.join(HERE, "ui_render_animation.py"), env=env)
         self.assertRegex(log, r"ui_render_animation \[ *[0-9.]+s\] done")
         self.assertEqual(log.count("with AO"), 3, log)
-        ui_aos = []
-        for frame in (1, 2, 3):
-            ao, _ = self.assert_composite_is_beauty_times_ao(
-                os.path.join(folder, f"out_{frame:04d}.exr"),
-                os.path.join(folder, "passes", f"{frame:04d}.exr"))
-            ui_aos.append(ao)
+        ui_aos = self.assert_frames_are_beauty_times_ao(folder, 3)
         headless = self.folder("ui_anim/headless")
         self.blender.run(blend, "-o", os.path.join(headless, "out_####"), "-a", env={
             "SSAO_COMPOSITOR_EXPORT_DIR": os.path.join(headless, "export")})
@@ -350,6 +348,19 @@ class AddonTest(unittest.TestCase):
         self.assertLess(r["mean"], 0.97)
         self.assertTrue(r["same"])
 
+    def test_threads_follow_a_fixed_render_thread_count(self):
+        script = ("import bpy, sys\n"
+                  "compute = next(m for n, m in sys.modules.items() "
+                  "if n.endswith('ssao_compositor.compute'))\n"
+                  "render = bpy.context.scene.render\n"
+                  "render.threads_mode = 'AUTO'\n"
+                  "print('THREADS', compute.threads(bpy.context.scene))\n"
+                  "render.threads_mode = 'FIXED'\n"
+                  "render.threads = 3\n"
+                  "print('THREADS', compute.threads(bpy.context.scene))\n")
+        log = self.blender.run("--python-exit-code", "1", "--python-expr", script)
+        self.assertEqual(re.findall(r"^THREADS (\d+)$", log, re.M), ["0", "3"])
+
     def test_errors_are_reported_not_crashing(self):
         folder = self.folder("errors")
         blend = self.blender.build_scene("errors/scene", "--output",
@@ -369,6 +380,26 @@ class AddonTest(unittest.TestCase):
                      "except Exception as e:\n    print('RAISED', e)")
         log = self.blender.run(blend, "--python-exit-code", "1", "--python-expr", no_camera)
         self.assertIn("RAISED scene 'Scene' has no active camera", log)
+
+
+class PackageTest(unittest.TestCase):
+    """The zip carries the project's version (project() in CMakeLists.txt) in bl_info and in the
+    extension manifest: the one place the version is written is project()."""
+
+    def test_versions_come_from_the_project(self):
+        import ast
+        import tomllib
+        import zipfile
+        with open(os.path.join(HERE, "..", "..", "CMakeLists.txt")) as f:
+            project = re.search(r"project\(\w+ VERSION ([0-9.]+)", f.read()).group(1)
+        with zipfile.ZipFile(CONFIG["zip"]) as archive:
+            init = archive.read("ssao_compositor/__init__.py").decode()
+            manifest = tomllib.loads(archive.read(
+                "ssao_compositor/blender_manifest.toml").decode())
+        bl_info = next(ast.literal_eval(node.value) for node in ast.parse(init).body
+                       if isinstance(node, ast.Assign) and node.targets[0].id == "bl_info")
+        self.assertEqual(".".join(map(str, bl_info["version"])), project)
+        self.assertEqual(manifest["version"], project)
 
 
 class MissingLibraryTest(unittest.TestCase):

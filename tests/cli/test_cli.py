@@ -28,7 +28,7 @@ import numpy as np
 import OpenImageIO as oiio
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
-from image_files import read_image  # noqa: E402
+from image_files import read_image, write_multipart_exr  # noqa: E402
 
 SSAO = os.environ.get("SSAO_CLI", "")
 LIB = os.environ.get("SSAO_LIB", "")
@@ -294,23 +294,8 @@ class GoodRunTest(CliTestCase):
         # single-part file.
         self.assert_ok(self.run_ssao("--ao-only"))
         _, single = read_image(self.output)
-        layers = {}
-        for name in BLENDER_CHANNELS:
-            layers.setdefault(name.rsplit(".", 1)[0], []).append(name)
-        specs = []
-        for layer, names in layers.items():
-            spec = oiio.ImageSpec(WIDTH, HEIGHT, len(names), oiio.FLOAT)
-            spec.channelnames = tuple(names)
-            spec.attribute("name", layer)
-            specs.append(spec)
         multipart = self.path("multipart.exr")
-        out = oiio.ImageOutput.create(multipart)
-        self.assertTrue(out.open(multipart, specs), out.geterror())
-        for i, names in enumerate(layers.values()):
-            if i:
-                self.assertTrue(out.open(multipart, specs[i], "AppendSubimage"), out.geterror())
-            out.write_image(np.stack([self.planes[n] for n in names], axis=-1))
-        out.close()
+        write_multipart_exr(multipart, {n: self.planes[n] for n in BLENDER_CHANNELS})
         os.remove(self.output)
         self.assert_ok(self.run_ssao(multipart, "-o", self.output, "--camera", self.camera,
                                      "--radius", RADIUS, "--ao-only", default_paths=False))

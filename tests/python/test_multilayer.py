@@ -16,7 +16,7 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, os.path.join(HERE, "..", "..", "blender_addon"))
 sys.path.insert(0, os.path.join(HERE, ".."))
 import multilayer  # noqa: E402
-from image_files import read_image  # noqa: E402
+from image_files import read_image, write_multipart_exr  # noqa: E402
 
 
 def sample_planes(height=37, width=53):
@@ -63,26 +63,8 @@ class MultilayerTest(unittest.TestCase):
 
     def test_reads_single_and_multi_part_files_openimageio_wrote(self):
         names = sorted(self.planes)
-        height, width = self.planes[names[0]].shape
-        # One part per layer, as Blender 5.x writes multilayer files.
-        layers = {}
-        for name in names:
-            layers.setdefault(name.rsplit(".", 1)[0], []).append(name)
-        specs = []
-        for layer, channels in layers.items():
-            spec = oiio.ImageSpec(width, height, len(channels), oiio.FLOAT)
-            spec.channelnames = tuple(channels)
-            spec.attribute("name", layer)
-            spec.attribute("compression", "zip")
-            specs.append(spec)
         path = self.path("multipart.exr")
-        out = oiio.ImageOutput.create(path)
-        self.assertTrue(out.open(path, specs), out.geterror())
-        for i, (layer, channels) in enumerate(layers.items()):
-            if i:
-                self.assertTrue(out.open(path, specs[i], "AppendSubimage"), out.geterror())
-            out.write_image(np.stack([self.planes[c] for c in channels], axis=-1))
-        out.close()
+        write_multipart_exr(path, self.planes)  # one part per layer, as Blender 5.x writes
         planes, _ = multilayer.read(path)
         self.assertEqual(sorted(planes), names)
         for name in names:
