@@ -131,6 +131,9 @@ def compute_node(node, scene, passes):
     image = inner_tree.ao_image(node, width, height)
     image.pixels.foreach_set(rgba.ravel())
     image.update()
+    # 5.x's GPU compositor keeps its own copy of the image: tag it, or the UI compositor
+    # re-composites with the old AO (measured in 5.2.2).
+    image.update_tag()
     return np.ascontiguousarray(rgba[::-1, :, 0])
 
 

@@ -2,7 +2,7 @@
 """Operators: recompute the AO of the scene's SSAO nodes from the last render's passes."""
 import bpy
 
-from . import compute, inner_tree
+from . import compute, handlers
 
 
 class SSAO_OT_recompute(bpy.types.Operator):
@@ -22,8 +22,7 @@ class SSAO_OT_recompute(bpy.types.Operator):
             errors = [n.status for n in compute.ssao_nodes(scene)]
             self.report({'ERROR'}, "; ".join(errors) or "nothing to compute")
             return {'CANCELLED'}
-        for node in compute.ssao_nodes(scene):
-            inner_tree.nudge(node)
+        handlers.nudge_until_composited(scene)
         self.report({'INFO'}, "SSAO recomputed")
         return {'FINISHED'}
 

@@ -6,29 +6,47 @@ a screenshot of the window.
     xvfb-run -a -s "-screen 0 1600x900x24" blender --factory-startup -noaudio \
         --addons ssao_compositor SCENE.blend --python scripts/blender/ui_screenshot.py -- \
         --out DIR [--workspace Compositing|Layout] [--render-display SPLIT|WINDOW|NONE]
-        [--after-workspace NAME] [--change radius=1.5] [--timeout 240]
+        [--after-workspace NAME] [--change radius=1.5] [--compositor-device CPU|GPU]
+        [--timeout 240]
+
+With the add-on installed as an extension (4.2+; e.g. Blender 5.2 through
+scripts/blender/blender52.sh), enable it as --addons bl_ext.user_default.ssao_compositor.
+Tested in Blender 3.4.1 and 5.2.2.
 
 SCENE.blend is a scene whose compositor has an SSAO node between Render Layers and Composite
-(tests/blender/build_ssao_scene.py makes one; with BLENDER_USER_SCRIPTS pointing at a folder
-whose addons/ holds ssao_compositor when it is not installed in the user's profile).
+(in 5.x: the compositing node group's Group Output) (tests/blender/build_ssao_scene.py makes
+one; with BLENDER_USER_SCRIPTS pointing at a folder whose addons/ holds ssao_compositor when it
+is not installed in the user's profile).
 
 Everything runs from timers once the UI is up:
+  0. the file is opened again (when it is saved and unchanged): this closes the Quick Setup
+     splash that 5.2 showed over the file given on the command line (measured with a fresh
+     BLENDER_USER_CONFIG, i.e. no saved preferences); it would cover the editors.
   1. layout: the given workspace ("Compositing" has a compositor Node Editor, "Layout" has
      none). With --render-display SPLIT (default; needs Compositing) the compositor editor
      gets the window, its right part becomes an Image Editor showing the Render Result, and F12
      renders into it (preferences: render in "Keep User Interface"); WINDOW is Blender's
      default (F12 opens a new window with an Image Editor); NONE renders with no Image Editor.
      The SSAO node is selected and the node tree framed (its properties are on the node).
+     --compositor-device sets the scene's compositor device first (4.2+; 5.2's default is
+     GPU; 3.4 has only the CPU one); the report says which one ran.
   2. F12: bpy.ops.render.render('INVOKE_DEFAULT'); waits for the render job, then for the
-     add-on's main-thread timer (the node's status "Frame N: ... ms"), then until no render or
+     add-on's main-thread timer (the node's status "Frame N: ... ms", or "AO computed; open a
+     compositor Node Editor ..." when none is open), then until no render or
      compositor job ran for --settle seconds (compositor jobs are counted with composite_post).
   3. check: saves the Render Result as a multilayer EXR (its Combined pass = the beauty, its
-     Composite layer = what the compositor made) and compares Composite with Combined x AO
-     (the node's AO image): "AO applied" when they agree to 1e-3.
-  4. screenshots: DIR/compositor_node.png (the main window, bpy.ops.screen.screenshot),
-     DIR/window_N.png for any other window (the render window with WINDOW; these come out
-     garbled under Xvfb), DIR/screen.png (the whole X screen through ImageMagick's `import`,
-     when installed: every window as the user sees it).
+     Composite layer = what the compositor made; single-part before 5.0, one part per layer in
+     5.x) and compares Composite with Combined x AO (the node's AO image): "AO applied" when
+     they agree to 1e-3. The EXR is read with the add-on's own reader (multilayer.py: numpy +
+     zlib), so no OpenImageIO is needed in Blender's Python (5.2 in its Debian sid folder has
+     none).
+  4. screenshots: DIR/compositor_node.png (the main window), DIR/window_N.png for any other
+     window (the render window with WINDOW), DIR/screen.png (the whole X screen: every window
+     as the user sees it). Each is bpy.ops.screen.screenshot's image when that has any
+     non-black pixel (3.4 under Xvfb; its other windows come out garbled), else the window's
+     rectangle read from the X server (GetImage, x11_capture below): 5.2 under Xvfb with Mesa's
+     llvmpipe reads back an all-black frame buffer. screen.png comes from ImageMagick's
+     `import` when installed, else from x11_capture.
   5. --after-workspace NAME: switches the main window to that workspace, waits, checks again.
   6. --change NAME=VALUE: sets that node property (its update callback recomputes from the
      exported passes and nudges the compositor), waits, checks again, counts the renders that
@@ -37,16 +55,18 @@ Everything runs from timers once the UI is up:
      measurement) and DIR/ui_events.txt (handler events with times), and quits.
 
 Exit status: 0 when the run completed (whatever the checks found: read ui_report.json);
-1 on a timeout or an exception. The comparison needs numpy and OpenImageIO importable in
-Blender's Python (true for Debian's Blender, which uses the system Python); without
-OpenImageIO the EXRs are still written and the check is reported as skipped.
+1 on a timeout or an exception. The comparison needs numpy in Blender's Python (bundled with
+Blender; Debian's Blender uses the system's python3-numpy).
 """
 import argparse
 import json
 import os
+import socket
+import struct
 import sys
 import time
 import traceback
+import zlib
 
 import bpy
 
@@ -65,6 +85,8 @@ def parse_args():
                         help="switch to this workspace after the render, then check again")
     parser.add_argument("--change", default="radius=1.5",
                         help="NAME=VALUE node property to change after the render ('' skips)")
+    parser.add_argument("--compositor-device", choices=("CPU", "GPU"), default=None,
+                        help="set scene.render.compositor_device (4.2+); default: the file's")
     parser.add_argument("--timeout", type=float, default=240.0, help="seconds for everything")
     parser.add_argument("--settle", type=float, default=2.0,
                         help="seconds without compositor activity that count as done")
@@ -87,6 +109,7 @@ def log(message):
 
 
 def _event(name):
+    @bpy.app.handlers.persistent  # kept when the file is opened again (step 0)
     def handler(*_):
         EVENTS.append((now(), name))  # render thread in the UI: only record
     return handler
@@ -129,13 +152,25 @@ def ssao_node(scene):
 
 
 def tidy_node_editor(window):
-    """No backdrop, no sidebar. Region sizes change at the next redraw, which shifts the view:
-    frame the tree in a later timer step."""
+    """No backdrop, no sidebar, no asset shelf (4.x/5.x). Region sizes change at the next
+    redraw, which shifts the view: frame the tree in a later timer step."""
     area = find_area(window, "CompositorNodeTree")
     if area is not None:
-        area.spaces.active.show_backdrop = False
-        area.spaces.active.show_region_ui = False
+        space = area.spaces.active
+        space.show_backdrop = False
+        space.show_region_ui = False
+        if hasattr(space, "show_region_asset_shelf"):
+            space.show_region_asset_shelf = False
     return area is not None
+
+
+def preview_height(node):
+    """5.x draws a node's preview above the node, outside node.dimensions (3.4 inside): about
+    the node's width x the render's aspect ratio."""
+    if bpy.app.version < (5, 0, 0) or not getattr(node, "show_preview", False):
+        return 0.0
+    render = bpy.context.scene.render
+    return node.dimensions.x * render.resolution_y / max(render.resolution_x, 1)
 
 
 def frame_node_tree(window, node):
@@ -152,7 +187,7 @@ def frame_node_tree(window, node):
     view = region.view2d
     left = min(n.location.x for n in tree.nodes)
     right = max(n.location.x + n.dimensions.x for n in tree.nodes)
-    top = max(n.location.y for n in tree.nodes)
+    top = max(n.location.y + preview_height(n) for n in tree.nodes)
     bottom = min(n.location.y - n.dimensions.y for n in tree.nodes)
 
     def fraction():  # of the visible view the tree (plus a margin) needs
@@ -176,8 +211,8 @@ def frame_node_tree(window, node):
 
 
 def split_for_image_editor(window):
-    """The compositor editor gets the whole window (the other areas are closed), and its right
-    part becomes an Image Editor (for the Render Result)."""
+    """Generator step: the compositor editor gets the whole window (the other areas are
+    closed), and its right part becomes an Image Editor (for the Render Result)."""
     area = find_area(window, "CompositorNodeTree")
     if area is None:
         raise RuntimeError("SPLIT needs a compositor Node Editor (use --workspace Compositing)")
@@ -191,10 +226,11 @@ def split_for_image_editor(window):
     new = [a for a in window.screen.areas if a.as_pointer() not in before]
     if not new:
         raise RuntimeError("area_split made no area")
-    # The new area is the one on the right or the left; the image goes to the right one.
+    # The new area has x = width = 0 until the next redraw: wait for it, then the image goes
+    # to the one on the right (sorting at once put the image on the left in 5.2).
+    yield 0.5
     pair = sorted([area, new[0]], key=lambda a: a.x)
     pair[1].ui_type = 'IMAGE_EDITOR'
-    return pair[1]
 
 
 def show_render_result(window):
@@ -221,23 +257,174 @@ def image_editors(window_manager):
     return shown
 
 
+def is_black(path):
+    """True when the PNG at `path` has no non-black pixel (or cannot be read)."""
+    import numpy as np
+    try:
+        image = bpy.data.images.load(path, check_existing=False)
+    except RuntimeError:
+        return True
+    try:
+        width, height = image.size
+        pixels = np.empty(width * height * image.channels, np.float32)
+        image.pixels.foreach_get(pixels)
+        colour = pixels.reshape(-1, image.channels)[:, :3]
+        return colour.size == 0 or float(colour.max()) == 0.0
+    finally:
+        bpy.data.images.remove(image)
+
+
 def screenshot(window, path):
+    """Blender's screenshot of `window`; when it is all black (5.2 under Xvfb), the window's
+    rectangle as the X server shows it."""
     area = window.screen.areas[0]
     with bpy.context.temp_override(window=window, area=area):
         bpy.ops.screen.screenshot(filepath=path, check_existing=False)
-    log(f"saved {path}")
+    how = "bpy.ops.screen.screenshot"
+    if is_black(path):
+        try:
+            write_png(path, x11_capture((window.x, window.y, window.width, window.height)))
+            how = "X server (Blender's screenshot was all black)"
+        except Exception as error:  # keep the black one, say why
+            how = f"bpy.ops.screen.screenshot, all black; X capture failed: {error}"
+    REPORT.setdefault("screenshots", {})[path] = how
+    log(f"saved {path} ({how})")
 
 
 def screenshot_x_root(path):
-    """The whole X screen, every window as X shows it (ImageMagick's import), when available."""
+    """The whole X screen, every window as X shows it: ImageMagick's import when installed,
+    else x11_capture."""
     import shutil
     import subprocess
-    tool = shutil.which("import")
-    if not tool or not os.environ.get("DISPLAY"):
+    if not os.environ.get("DISPLAY"):
         return
-    result = subprocess.run([tool, "-window", "root", path], capture_output=True, text=True,
-                            timeout=60)
-    log(f"saved {path}" if result.returncode == 0 else f"import failed: {result.stderr}")
+    tool = shutil.which("import")
+    if tool:
+        result = subprocess.run([tool, "-window", "root", path], capture_output=True,
+                                text=True, timeout=60)
+        how = "import" if result.returncode == 0 else f"import failed: {result.stderr}"
+    else:
+        try:
+            write_png(path, x11_capture())
+            how = "X server"
+        except Exception as error:
+            how = f"X capture failed: {error}"
+    REPORT.setdefault("screenshots", {})[path] = how
+    log(f"saved {path} ({how})")
+
+
+# --- reading the X screen without any X library (Blender's Python has none) ------------------
+# X11 protocol (x.org "X Window System Protocol"): connection setup with the display's
+# MIT-MAGIC-COOKIE-1 from $XAUTHORITY, then one GetImage (ZPixmap) of the root window.
+
+def _pad4(n):
+    return (4 - n % 4) % 4
+
+
+def _xauth_cookie(display_number):
+    """(auth name, cookie) for the display from the Xauthority file, or (b"", b"")."""
+    path = os.environ.get("XAUTHORITY") or os.path.expanduser("~/.Xauthority")
+    try:
+        with open(path, "rb") as stream:
+            data = stream.read()
+    except OSError:
+        return b"", b""
+    at = 0
+
+    def field():
+        nonlocal at
+        size, = struct.unpack_from(">H", data, at)
+        value = data[at + 2:at + 2 + size]
+        at += 2 + size
+        return value
+
+    while at + 2 <= len(data):
+        at += 2  # address family
+        field()  # address
+        number, name, cookie = field(), field(), field()
+        if name == b"MIT-MAGIC-COOKIE-1" and number in (b"", display_number.encode()):
+            return name, cookie
+    return b"", b""
+
+
+def _receive(sock, size):
+    chunks, left = [], size
+    while left:
+        chunk = sock.recv(min(left, 1 << 20))
+        if not chunk:
+            raise ConnectionError("the X server closed the connection")
+        chunks.append(chunk)
+        left -= len(chunk)
+    return b"".join(chunks)
+
+
+def x11_capture(rect=None):
+    """The X screen ($DISPLAY), or its rectangle (x, y, width, height) in Blender's window
+    coordinates (y from the bottom of the screen up: window.x, .y, .width, .height; measured
+    with 5.2's render window under Xvfb, which has no window manager), as an (height, width,
+    3) uint8 RGB array, row 0 on top. Needs a 24-bit TrueColor root window with 32 bits per
+    pixel, least significant byte first (Xvfb's -screen WxHx24)."""
+    import numpy as np
+    host, _, rest = os.environ["DISPLAY"].rpartition(":")
+    number = rest.split(".")[0]
+    if host in ("", "unix"):
+        sock = socket.socket(socket.AF_UNIX, socket.SOCK_STREAM)
+        sock.connect(f"/tmp/.X11-unix/X{number}")
+    else:
+        sock = socket.create_connection((host, 6000 + int(number)))
+    with sock:
+        sock.settimeout(30)
+        name, cookie = _xauth_cookie(number)
+        sock.sendall(struct.pack("<BxHHHHxx", ord("l"), 11, 0, len(name), len(cookie)) +
+                     name + b"\0" * _pad4(len(name)) + cookie + b"\0" * _pad4(len(cookie)))
+        status, reason_length, _, _, length = struct.unpack("<BBHHH", _receive(sock, 8))
+        setup = _receive(sock, length * 4)
+        if status != 1:
+            raise ConnectionError("the X server refused the connection: " +
+                                  setup[:reason_length].decode(errors="replace"))
+        vendor_length, = struct.unpack_from("<H", setup, 16)
+        format_count, byte_order = struct.unpack_from("<BB", setup, 21)
+        bits_per_pixel = {}
+        at = 32 + vendor_length + _pad4(vendor_length)
+        for _ in range(format_count):
+            depth, bits = struct.unpack_from("<BB", setup, at)
+            bits_per_pixel[depth] = bits
+            at += 8
+        root, = struct.unpack_from("<I", setup, at)
+        screen_width, screen_height = struct.unpack_from("<HH", setup, at + 20)
+        x, y, width, height = rect or (0, 0, screen_width, screen_height)
+        y = screen_height - y - height  # X counts from the top
+        x, y = max(0, x), max(0, y)
+        width, height = min(width, screen_width - x), min(height, screen_height - y)
+        # GetImage (opcode 73), format ZPixmap (2), all planes
+        sock.sendall(struct.pack("<BBHIhhHHI", 73, 2, 5, root, x, y, width, height,
+                                 0xFFFFFFFF))
+        reply = _receive(sock, 32)
+        if reply[0] != 1:
+            raise RuntimeError(f"X GetImage failed (error code {reply[1]})")
+        depth = reply[1]
+        length, = struct.unpack_from("<I", reply, 4)
+        data = _receive(sock, length * 4)
+    if depth != 24 or bits_per_pixel.get(depth) != 32 or byte_order != 0:
+        raise RuntimeError(f"unsupported X screen: depth {depth}, "
+                           f"{bits_per_pixel.get(depth)} bits per pixel, byte order {byte_order}")
+    pixels = np.frombuffer(data, np.uint8, width * height * 4).reshape(height, width, 4)
+    return pixels[:, :, 2::-1].copy()  # B, G, R, unused -> R, G, B
+
+
+def write_png(path, rgb):
+    """An 8-bit RGB PNG from an (height, width, 3) uint8 array, row 0 on top."""
+    height, width, _ = rgb.shape
+    raw = b"".join(b"\0" + rgb[row].tobytes() for row in range(height))
+
+    def chunk(kind, body):
+        return (struct.pack(">I", len(body)) + kind + body +
+                struct.pack(">I", zlib.crc32(kind + body)))
+
+    with open(path, "wb") as stream:
+        stream.write(b"\x89PNG\r\n\x1a\n" +
+                     chunk(b"IHDR", struct.pack(">IIBBBBB", width, height, 8, 2, 0, 0, 0)) +
+                     chunk(b"IDAT", zlib.compress(raw, 6)) + chunk(b"IEND", b""))
 
 
 def addon_module(name):
@@ -264,28 +451,26 @@ def node_ao(node):
 
 
 def compare(exr_path, ao):
-    """Composite vs Combined and vs Combined x AO, from a multilayer Render Result EXR."""
-    try:
-        import numpy as np
-        import OpenImageIO as oiio
-    except ImportError as error:
-        return {"skipped": f"no numpy/OpenImageIO in Blender's Python ({error})"}
-    image = oiio.ImageBuf(exr_path)
-    spec = image.spec()
-    names = list(spec.channelnames)
-    pixels = image.get_pixels(oiio.FLOAT)  # (height, width, channels), row 0 on top
+    """Composite vs Combined and vs Combined x AO, from a multilayer Render Result EXR (read
+    with the add-on's reader: every part of 5.x's multi-part files)."""
+    import numpy as np
+    planes, _ = addon_module("multilayer").read(exr_path)  # {channel: (h, w)}, row 0 on top
+    names = list(planes)
 
     def channels(prefix):
-        idx = [names.index(f"{prefix}.{c}") for c in "RGB" if f"{prefix}.{c}" in names]
-        return pixels[:, :, idx] if len(idx) == 3 else None
+        found = [planes.get(f"{prefix}.{c}") for c in "RGB"]
+        return None if any(p is None for p in found) else np.stack(found, axis=-1)
 
     layers = [n[:-len(".R")] for n in names
               if n.endswith(".Combined.R") and not n.startswith("Composite.")]
     combined = channels(layers[0]) if layers else None
     composite = channels("Composite.Combined")
-    result = {"channels": len(names)}
+    result = {"channels": len(names), "combined_layer": layers[0] if layers else None}
     if combined is None or composite is None:
         result["error"] = f"Combined or Composite missing; channels: {names[:20]}"
+        return result
+    if composite.shape != ao.shape + (3,):
+        result["error"] = f"Composite is {composite.shape[:2]}, the AO {ao.shape}"
         return result
     product = combined * ao[:, :, None]
     result.update({
@@ -316,19 +501,33 @@ def wait_quiet(since):
     yield from wait_until(quiet, "the compositor to settle")
 
 
+def reopen_file():
+    """Opens the file again (step 0): closes 5.2's Quick Setup splash. Only a saved, unchanged
+    file (nothing is lost)."""
+    if not bpy.data.filepath or bpy.data.is_dirty:
+        return False
+    bpy.ops.wm.open_mainfile(filepath=bpy.data.filepath)
+    return True
+
+
 def scenario():
     yield 1.0  # the UI is up
+    REPORT["reopened"] = reopen_file()
+    yield 1.0
     window = main_window()
     scene = bpy.context.scene
     node = ssao_node(scene)
     prefs = bpy.context.preferences
     prefs.use_preferences_save = False  # never write the user's preferences
     prefs.view.smooth_view = 0  # framing takes effect at once
+    if ARGS.compositor_device and hasattr(scene.render, "compositor_device"):
+        scene.render.compositor_device = ARGS.compositor_device
+    REPORT["compositor_device"] = getattr(scene.render, "compositor_device", "CPU (only one)")
     REPORT["workspace"] = ARGS.workspace
     window.workspace = bpy.data.workspaces[ARGS.workspace]
     yield 0.5
     if ARGS.render_display == "SPLIT":
-        split_for_image_editor(window)
+        yield from split_for_image_editor(window)
         prefs.view.render_display_type = 'NONE'
     else:
         prefs.view.render_display_type = ARGS.render_display
@@ -353,7 +552,8 @@ def scenario():
     REPORT["render_seconds"] = now() - t_render
     log(f"render done in {REPORT['render_seconds']:.1f} s; waiting for the add-on")
     t_post = min(t for t, n in EVENTS if n == "render_post" and t >= t_render)
-    yield from wait_until(lambda: node.status.startswith(("Frame", "Error")),
+    # "AO computed; open a compositor Node Editor ..." when none is open (e.g. Layout)
+    yield from wait_until(lambda: node.status.startswith(("Frame", "Error", "AO computed")),
                           "the add-on's AO computation")
     REPORT["status_after_render"] = node.status
     log(f"node status: {node.status}")
@@ -398,9 +598,14 @@ def scenario():
 
 
 def check(label, scene, node, since):
+    """Saves DIR/render_result_LABEL.exr and the node's AO as DIR/ao_LABEL.npy (row 0 on top;
+    for checking outside Blender), and compares them."""
+    import numpy as np
     path = os.path.join(OUT, f"render_result_{label}.exr")
     save_render_result(scene, path)
-    result = compare(path, node_ao(node))
+    ao = node_ao(node)
+    np.save(os.path.join(OUT, f"ao_{label}.npy"), ao)
+    result = compare(path, ao)
     result["compositor_jobs_since"] = count("composite_post", since)
     log(f"{label}: {json.dumps(result)}")
     return result
@@ -418,7 +623,8 @@ def verdict(result):
 
 
 def finish(code):
-    log(f"RESULT workspace {ARGS.workspace}, render display {ARGS.render_display}: "
+    log(f"RESULT Blender {bpy.app.version_string}, workspace {ARGS.workspace}, render display "
+        f"{ARGS.render_display}, compositor device {REPORT.get('compositor_device')}: "
         f"after F12: {verdict(REPORT.get('after_render'))}")
     if ARGS.after_workspace:
         log(f"RESULT after switching to {ARGS.after_workspace}: "

@@ -259,6 +259,26 @@ class AddonTest(unittest.TestCase):
             np.testing.assert_allclose(ao, aos["CPU"], rtol=0, atol=1e-5, err_msg=device)
 
     @unittest.skipUnless(shutil.which("xvfb-run"), "needs xvfb-run (apt-get install xvfb)")
+    def test_ui_f12_and_a_property_change_apply_the_ao(self):
+        # F12 in the UI with the compositor and the Render Result in view, then a property
+        # change: the Render Result's Composite must be its Combined x the node's AO each time
+        # (scripts/blender/ui_screenshot.py measures it), with no render for the change. In
+        # 5.2 this runs on its default GPU compositor.
+        folder = self.folder("ui_f12")
+        blend = self.blender.build_scene("ui_f12/scene", "--output",
+                                         os.path.join(folder, "out_####.png"))
+        script = os.path.join(HERE, "..", "..", "scripts", "blender", "ui_screenshot.py")
+        self.blender.run_ui(blend, script, "--out", os.path.join(folder, "shots"),
+                            env={"SSAO_COMPOSITOR_EXPORT_DIR": os.path.join(folder, "export")})
+        with open(os.path.join(folder, "shots", "ui_report.json")) as f:
+            report = json.load(f)
+        self.assertTrue(report["after_render"]["ao_applied"], report["after_render"])
+        self.assertLess(report["after_render"]["min_ao"], 0.9, "there is AO to apply")
+        self.assertTrue(report["change"]["check"]["ao_applied"], report["change"])
+        self.assertEqual(report["change"]["renders_meanwhile"], 0)
+        self.assertTrue(report["change"]["status"].startswith("Frame 1"), report["change"])
+
+    @unittest.skipUnless(shutil.which("xvfb-run"), "needs xvfb-run (apt-get install xvfb)")
     def test_ui_animation_writes_each_frame_with_its_own_ao(self):
         # Ctrl+F12 in the UI, where render handlers run in the render thread: every written
         # frame must carry its own AO, the one a headless render (-a) of the same frame gets.
