@@ -66,7 +66,9 @@ class Blender:
 
     def run_ui(self, blend, script, *args, env=None, timeout=400):
         """Blender's UI under Xvfb (xvfb-run) on `blend`, driven by `script`."""
-        command = ["xvfb-run", "-a", "-s", "-screen 0 1280x720x24"] + \
+        # -a alone starts every xvfb-run at display 99: two at once (ctest -j) can collide.
+        display = 100 + os.getpid() % 800
+        command = ["xvfb-run", "-a", "-n", str(display), "-s", "-screen 0 1280x720x24"] + \
             shlex.split(CONFIG["blender"]) + ["--factory-startup", "-noaudio",
                                               "--addons", self.module, blend,
                                               "--python", script, "--"] + list(args)
