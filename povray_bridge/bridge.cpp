@@ -298,8 +298,8 @@ double compute_and_write(const Options& o, AoInputs& in, const Reporter& report)
   job.set_image("ao", ao.data(), in.width, in.height, 1);
   job.set_progress(&progress_callback, nullptr);
 
-  report.begin("AO (%s, %d samples, normals %s)... ", job.get_string("variant").c_str(),
-               job.get_int("samples"), in.normals.empty() ? "from depth" : "from the normal pass");
+  report.begin("AO (%s, normals %s)... ", job.settings_summary().c_str(),
+               in.normals.empty() ? "from depth" : "from the normal pass");
   const auto start = Clock::now();
   const ssao_status status = ssao_job_run(job.get());
   const double seconds = seconds_since(start);

@@ -195,11 +195,11 @@ void print_summary(const Options& options, const ssao_io::Job& job, const Inputs
   char mean[64] = "n/a";
   if (count > 0) std::snprintf(mean, sizeof mean, "%.4f", sum / static_cast<double>(count));
   std::fprintf(stderr,
-               "ssao: %s: %dx%d, variant %s, %d samples, normals %s, %.1f ms, mean AO %s over "
+               "ssao: %s: %dx%d, variant %s, normals %s, %.1f ms, mean AO %s over "
                "%zu geometry pixels\n",
                options.output.c_str(), in.image.width, in.image.height,
-               job.get_string("variant").c_str(), job.get_int("samples"),
-               in.normal.empty() ? "from depth" : "from pass", milliseconds, mean, count);
+               job.settings_summary().c_str(), in.normal.empty() ? "from depth" : "from pass",
+               milliseconds, mean, count);
 }
 
 }  // namespace

@@ -91,6 +91,17 @@ class Job {
     return buffer;
   }
 
+  // "hemisphere, quality medium" plus any count set explicitly (", 16 samples"): what the
+  // front ends print about a run (a count left at 0 comes from the quality preset).
+  std::string settings_summary() const {
+    std::string out = get_string("variant") + ", quality " + get_string("quality");
+    for (const char* count : {"samples", "slices", "steps"}) {
+      const int value = get_int(count);
+      if (value > 0) out += ", " + std::to_string(value) + " " + count;
+    }
+    return out;
+  }
+
   // Attaches a caller-owned image (see ssao_job_set_image); strides in bytes, 0 = packed.
   void set_image(const std::string& name, float* data, int width, int height, int channels,
                  std::ptrdiff_t pixel_stride = 0, std::ptrdiff_t row_stride = 0) {
