@@ -17,7 +17,8 @@ from . import compat, inner_tree, ssao_native
 SAVED_EXPORT_DIR = os.path.join(tempfile.gettempdir(), "ssao_compositor")
 PROCESS_EXPORT_DIR = os.path.join(tempfile.gettempdir(), f"ssao_compositor_{os.getpid()}")
 # EEVEE writes its Depth pass as half floats with 65504 (the largest half) on the background
-# in 3.x (4.2+ writes the clip end, which the camera's clip_end already covers).
+# in 3.x; 4.x writes the clip end and 5.x 1e10, which the camera's clip_end covers, so setting
+# 65504 for every EEVEE render is harmless there.
 EEVEE_BACKGROUND_DEPTH = 65504.0
 
 # The library parameters the node exposes, by their library names (the rest are set here:
@@ -25,6 +26,8 @@ EEVEE_BACKGROUND_DEPTH = 65504.0
 NODE_PARAMETERS = ("variant", "radius", "quality", "resolution", "samples", "slices", "steps",
                    "bias", "thickness", "sample_clustering", "sphere_mode", "denoise", "strength",
                    "power", "remap_min", "remap_max", "seed")
+
+HELPER_SCENE_PREFIX = ".SSAO recomposite "  # recomposite.py's hidden scenes
 
 _library = None
 preferred_export_dir = ""  # set by preferences.py
@@ -55,29 +58,34 @@ def ssao_nodes(scene):
     return [n for n in tree.nodes if n.bl_idname == inner_tree.NODE_IDNAME and not n.mute]
 
 
-def all_ssao_nodes():
-    """(scene, node) for every SSAO node of every scene, muted ones too."""
+def compositor_trees():
+    """(scene, tree) for each compositing tree once (by pointer: before 5.0 every scene's tree
+    has the same name), helper scenes left out."""
     seen = set()
     for scene in bpy.data.scenes:
         tree = compat.compositor_tree(scene)
-        if tree is None or tree.name in seen:
+        if tree is None or tree.as_pointer() in seen or \
+                scene.name.startswith(HELPER_SCENE_PREFIX):
             continue
-        seen.add(tree.name)
-        for node in tree.nodes:
-            if node.bl_idname == inner_tree.NODE_IDNAME:
-                yield scene, node
+        seen.add(tree.as_pointer())
+        yield scene, tree
+
+
+def all_ssao_nodes():
+    """(scene, node) for every SSAO node of every scene, muted ones too."""
+    for scene, tree in list(compositor_trees()):
+        for node in [n for n in tree.nodes if n.bl_idname == inner_tree.NODE_IDNAME]:
+            yield scene, node
 
 
 def scene_of_tree(tree):
-    for scene in bpy.data.scenes:
-        if compat.compositor_tree(scene) == tree:
-            return scene
-    return None
+    return next((scene for scene, t in compositor_trees() if t == tree), None)
 
 
 def configure_node(node, folder=None):
-    """Points the node's exporter at this process's folder (paths saved in a .blend belong to
-    the process that saved it) and makes sure it has an AO image of the render's size."""
+    """Points the node's exporter at this session's export folder (paths saved in a .blend
+    belong to the session that saved it) and makes sure it has an AO image of the render's
+    size."""
     scene = node.id_data and scene_of_tree(node.id_data)
     size = camera_module.render_size(scene) if scene is not None else None
     inner_tree.configure(node, folder or export_dir(), size)
@@ -144,9 +152,10 @@ def compute_frame(scene, frame, since=0.0):
     are reported on the node and in the console."""
     done = {}
     for node in ssao_nodes(scene):
-        path = inner_tree.export_path(node, frame, (SAVED_EXPORT_DIR,), since)
+        # A render of this session may have exported where a saved file points (see above).
+        path = inner_tree.export_path(node, frame, (SAVED_EXPORT_DIR,) if since else (), since)
         try:
-            if not os.path.exists(path):
+            if path is None:
                 raise RuntimeError(compat.compositor_cannot_export(scene) or
                                    f"no exported passes for frame {frame} (is the node's output "
                                    "connected to the compositor's output?)")
@@ -177,6 +186,6 @@ def compute_ao(scene=None, node=None, render=True):
     if render:
         bpy.ops.render.render(scene=scene.name)
     path = inner_tree.export_path(node, scene.frame_current)
-    if not os.path.exists(path):
+    if path is None:
         raise RuntimeError(f"no exported passes for frame {scene.frame_current}: render first")
     return compute_node(node, scene, read_export(path))

@@ -65,16 +65,21 @@ def _remove(path):
 
 @bpy.app.handlers.persistent
 def _on_render_pre(scene, *_):
-    """A file loaded before the add-on registered (5.x: `blender -b file --addons ...` registers
-    with bpy.data out of reach) still carries its nodes as group nodes: turn them back now."""
     global _render_started
     if recomposite.is_running():
         return
     if bpy.app.background or not _written_frames:  # (the UI: the animation's first frame)
         _render_started = time.time() - 1.0  # file times may be rounded to the second
-    if saved_form.from_group_nodes():
-        for _, node in compute.all_ssao_nodes():
-            compute.configure_node(node)
+    if not bpy.app.background:
+        return  # the render thread: nothing more here
+    # A frame whose re-composite failed or was never written must not lend its result to this
+    # one.
+    for passes, _ in _recomposited.values():
+        _remove(passes)
+    _recomposited.clear()
+    # A file loaded before the add-on registered (5.x: `blender -b file --addons ...` registers
+    # with bpy.data out of reach) still carries its nodes as group nodes: turn them back now.
+    set_up_nodes()
 
 
 @bpy.app.handlers.persistent
@@ -82,11 +87,11 @@ def _on_render_post(scene, *_):
     if recomposite.is_running() or not compute.ssao_nodes(scene):
         return
     if not bpy.app.background:
-        _pending_frames.append((scene.name, scene.frame_current))
-        if not bpy.app.timers.is_registered(_process_pending):
-            bpy.app.timers.register(_process_pending, first_interval=0.1)
+        _pending_frames.append((scene.name, scene.frame_current))  # for _process_pending
         return
     frame = scene.frame_current
+    # Headless, the scene's objects (the camera) still hold the frame the file was saved at.
+    scene.frame_set(frame)
     aos = compute.compute_frame(scene, frame, _render_started)
     if not aos:
         return
@@ -140,8 +145,9 @@ def _on_render_write(scene, *_):
 
 
 def _process_pending():
-    """UI: main-thread work after a render (handlers run in the render thread there)."""
-    if bpy.app.is_job_running('RENDER'):
+    """UI: main-thread work after a render (handlers run in the render thread there, where no
+    timer may be registered: this one polls, from register() on)."""
+    if bpy.app.is_job_running('RENDER') or not (_written_frames or _pending_frames):
         return 0.2
     if _written_frames:
         # Outside a render handler the helper scene can go: the next one copies the compositor
@@ -165,10 +171,22 @@ def _process_pending():
         finally:
             scene.frame_set(current)
             _remove(passes)
-    current = _pending_frames[-1] if _pending_frames else None
+    last = _pending_frames[-1] if _pending_frames else None
     _pending_frames.clear()
-    scene = bpy.data.scenes.get(current[0]) if current else None
-    if scene is not None and compute.compute_frame(scene, current[1], _render_started):
+    scene = bpy.data.scenes.get(last[0]) if last else None
+    if scene is None:
+        return 0.2
+    # The Render Result shows the last frame rendered; after an animation the scene is back
+    # at its own frame: that frame's camera for the AO, then the scene as it was.
+    current = scene.frame_current
+    try:
+        if last[1] != current:
+            scene.frame_set(last[1])
+        computed = compute.compute_frame(scene, last[1], _render_started)
+    finally:
+        if scene.frame_current != current:
+            scene.frame_set(current)
+    if computed:
         nudge_until_composited(scene)
         if not _compositor_editor_open():
             message = ("AO computed; open a compositor Node Editor (and an Image Editor "
@@ -176,7 +194,7 @@ def _process_pending():
             for node in compute.ssao_nodes(scene):
                 node.status = message
             report(message)
-    return None
+    return 0.2
 
 
 _nudge = {"scene": None, "tries": 0, "composited": False}
@@ -224,7 +242,7 @@ def parameter_changed(node, scene):
             scene is None:
         return
     path = inner_tree.export_path(node, scene.frame_current)
-    if not os.path.exists(path):
+    if path is None:
         node.status = "Render (F12) to compute the AO"
         return
     try:
@@ -236,11 +254,36 @@ def parameter_changed(node, scene):
         report(str(error), error=True)
 
 
+def _each_node(action, what):
+    """Runs action(scene, node) for every SSAO node; one node's failure (a damaged inner tree,
+    a linked library tree) is reported and does not stop the others or the event."""
+    for scene, node in list(compute.all_ssao_nodes()):
+        try:
+            action(scene, node)
+        except Exception as error:
+            report(f"node '{node.name}' of scene '{scene.name}': {what} failed: {error}",
+                   error=True)
+
+
+def set_up_nodes():
+    """The file's nodes ready for this session: group nodes of a saved file turned back into
+    SSAO nodes, exporters pointed at this session's folder, AO images of the render's size."""
+    saved_form.from_group_nodes()
+    _each_node(lambda scene, node: compute.configure_node(node), "setting up")
+
+
+def _pack_and_point_at_saved_folder(scene, node):
+    image = inner_tree.ao_image_if_any(node)
+    # Pack what is in memory; packing an unchanged packed image again would re-read a file
+    # that does not exist and drop the pixels.
+    if image is not None and image.has_data and (image.is_dirty or not image.packed_file):
+        image.pack()
+    inner_tree.point_exporter(node, compute.SAVED_EXPORT_DIR)
+
+
 @bpy.app.handlers.persistent
 def _on_load_post(*_):
-    saved_form.from_group_nodes()
-    for _, node in compute.all_ssao_nodes():
-        compute.configure_node(node)
+    set_up_nodes()
 
 
 @bpy.app.handlers.persistent
@@ -249,21 +292,13 @@ def _on_save_pre(*_):
     # that a file opened without the add-on (or before it is enabled) writes somewhere harmless
     # and, with the add-on, where it will look.
     recomposite.remove_helpers()
-    for _, node in compute.all_ssao_nodes():
-        image = inner_tree.inner(node, inner_tree.AO_NODE).image
-        # Pack what is in memory; packing an unchanged packed image again would re-read a file
-        # that does not exist and drop the pixels.
-        if image is not None and image.has_data and (image.is_dirty or not image.packed_file):
-            image.pack()
-        inner_tree.point_exporter(node, compute.SAVED_EXPORT_DIR)
+    _each_node(_pack_and_point_at_saved_folder, "packing the AO")
     saved_form.to_group_nodes()
 
 
 @bpy.app.handlers.persistent
 def _on_save_post(*_):
-    saved_form.from_group_nodes()
-    for _, node in compute.all_ssao_nodes():
-        inner_tree.point_exporter(node, compute.export_dir())
+    set_up_nodes()
 
 
 _HANDLERS = (("render_pre", _on_render_pre), ("render_post", _on_render_post),
@@ -275,19 +310,27 @@ _HANDLERS = (("render_pre", _on_render_pre), ("render_post", _on_render_post),
 def register():
     for name, handler in _HANDLERS:
         getattr(bpy.app.handlers, name).append(handler)
-    if compute.export_dir() == compute.PROCESS_EXPORT_DIR:
-        # This session's exports are of no use to any other: remove them when Blender quits.
-        atexit.register(shutil.rmtree, compute.PROCESS_EXPORT_DIR, ignore_errors=True)
+    # This session's exports are of no use to any other: remove them when Blender quits.
+    atexit.register(shutil.rmtree, compute.PROCESS_EXPORT_DIR, ignore_errors=True)
+    if not bpy.app.background:
+        bpy.app.timers.register(_process_pending, first_interval=0.2, persistent=True)
     # Nodes of a file that is already open (enabling the add-on after loading).
     try:
-        saved_form.from_group_nodes()
-        for _, node in compute.all_ssao_nodes():
-            compute.configure_node(node)
+        set_up_nodes()
     except AttributeError:  # bpy.data is restricted while add-ons register at start-up
         pass
 
 
 def unregister():
+    for timer in (_process_pending, _check_nudge):
+        if bpy.app.timers.is_registered(timer):
+            bpy.app.timers.unregister(timer)
+    # Without the add-on a node is undefined (5.x: a black composite); as a group node it
+    # still multiplies by its last AO.
+    try:
+        saved_form.to_group_nodes()
+    except Exception as error:
+        report(f"keeping the nodes as group nodes failed: {error}", error=True)
     for name, handler in _HANDLERS:
         handlers = getattr(bpy.app.handlers, name)
         if handler in handlers:

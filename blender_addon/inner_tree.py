@@ -10,6 +10,7 @@ composites (with the last computed AO) where the add-on is not installed:
                                                      -> Output AO
 """
 import os
+import uuid
 
 import bpy
 import numpy as np
@@ -63,6 +64,11 @@ def build(ssao_id):
     return tree
 
 
+def new_id():
+    """A node's id: names its export files, inner tree and AO image."""
+    return uuid.uuid4().hex[:12]
+
+
 def inner(node, name):
     return node.node_tree.nodes.get(name) if node.node_tree is not None else None
 
@@ -71,14 +77,14 @@ def export_path(node, frame, extra_folders=(), since=0.0):
     """Where the node's exporter wrote `frame`, from its own settings (a file saved by another
     session, or opened before the add-on was enabled, keeps the folder it was saved with): the
     newest file written at or after `since` (a time.time()) in that folder or `extra_folders`;
-    the expected path when there is none."""
+    None when there is none."""
     folder, prefix = compat.file_output_target(inner(node, EXPORT_NODE))
     folders = [bpy.path.abspath(folder)] + list(extra_folders)
     # 5.x writes a still render's File Output files without the frame number.
     candidates = [os.path.join(f, name) for f in folders
                   for name in (f"{prefix}{frame:04d}.exr", f"{prefix}.exr")]
     existing = [p for p in candidates if os.path.isfile(p) and os.path.getmtime(p) >= since]
-    return max(existing, key=os.path.getmtime) if existing else candidates[0]
+    return max(existing, key=os.path.getmtime) if existing else None
 
 
 def point_exporter(node, folder):
@@ -109,9 +115,24 @@ def set_exporter_muted(node, muted):
         exporter.mute = muted
 
 
+def forget_ao_image(node):
+    """The node's inner AO image node lets go of its image (a copied node makes its own)."""
+    holder = inner(node, AO_NODE)
+    if holder is not None:
+        holder.image = None
+
+
+def ao_image_if_any(node):
+    holder = inner(node, AO_NODE)
+    return holder.image if holder is not None else None
+
+
 def ao_image(node, width, height):
     """The node's AO image (float, non-colour data), made or resized as needed."""
     holder = inner(node, AO_NODE)
+    if holder is None:
+        raise RuntimeError(f"the node's inner tree has no '{AO_NODE}' image node (was it "
+                           "edited?): delete the node and add it again")
     image = holder.image
     if image is None:
         image = bpy.data.images.new(f".SSAO AO {node.ssao_id}", width, height, alpha=False,

@@ -1,11 +1,9 @@
 # SPDX-License-Identifier: MIT
 """The compositor node CompositorNodeSSAO: a custom group node (its inner tree: inner_tree.py)
 whose properties are libssao's parameters, with the library's names, defaults and ranges."""
-import uuid
-
 import bpy
 
-from . import compat, compute, handlers, inner_tree, ssao_native
+from . import compat, compute, handlers, inner_tree, recomposite, ssao_native
 from .compute import NODE_PARAMETERS
 
 # Why the library's parameter table could not be read (shown on the node), or None.
@@ -62,17 +60,20 @@ class CompositorNodeSSAO(bpy.types.CompositorNodeCustomGroup):
     status: bpy.props.StringProperty(name="Status", options={'SKIP_SAVE'})
 
     def init(self, context):
-        self.ssao_id = uuid.uuid4().hex[:12]
+        self.ssao_id = inner_tree.new_id()
         self.node_tree = inner_tree.build(self.ssao_id)
         compute.configure_node(self)
 
     def copy(self, node):
-        # A node copied into another tree (a copied scene, such as the re-compositing helper)
-        # keeps sharing the inner tree and AO image; a duplicate in the same tree gets its own.
-        if self.id_data != node.id_data:
+        # The re-compositing helper's copy shares the inner tree and AO image (it composites
+        # with that AO); any other copy (Shift+D, a scene's Full Copy) gets its own id, inner
+        # tree and AO image, or the two would overwrite each other's export and AO.
+        if recomposite.is_copying_helper():
             return
-        self.ssao_id = uuid.uuid4().hex[:12]
-        self.node_tree = node.node_tree.copy()
+        self.ssao_id = inner_tree.new_id()
+        self.node_tree = node.node_tree.copy() if node.node_tree is not None else \
+            inner_tree.build(self.ssao_id)
+        inner_tree.forget_ao_image(self)
         compute.configure_node(self)
 
     def free(self):

@@ -2,13 +2,12 @@
 """The add-on's preferences: where the passes are exported, and what the library says."""
 import bpy
 
-from . import compute
+from . import compute, handlers
 
 
 def _on_export_dir_changed(preferences, context):
     compute.preferred_export_dir = bpy.path.abspath(preferences.export_dir)
-    for _, node in compute.all_ssao_nodes():
-        compute.configure_node(node)
+    handlers.set_up_nodes()
 
 
 class SSAOPreferences(bpy.types.AddonPreferences):

@@ -11,8 +11,17 @@ import bpy
 
 from . import compat, compute, inner_tree, multilayer
 
-HELPER_PREFIX = ".SSAO recomposite "
+HELPER_PREFIX = compute.HELPER_SCENE_PREFIX
+_copying_helper = False  # see is_copying_helper()
 PASSES_IMAGE_PREFIX = ".SSAO passes "
+
+
+# Render settings the re-composite takes from the scene each time (the helper is a copy made
+# once per session, 5.x aside).
+_RENDER_SETTINGS = ("resolution_x", "resolution_y", "resolution_percentage", "pixel_aspect_x",
+                    "pixel_aspect_y", "use_border", "use_crop_to_border", "border_min_x",
+                    "border_max_x", "border_min_y", "border_max_y", "film_transparent",
+                    "use_file_extension")
 
 
 def passes_path(scene, frame):
@@ -43,25 +52,42 @@ def helper_scene(scene):
     """The hidden copy of `scene` that re-composites it. Kept and reused (removing a scene in a
     render handler crashes); in 5.x its compositing tree, a data-block the copy would share, is
     copied afresh each time so that it follows the scene's."""
+    global _copying_helper
     name = HELPER_PREFIX + scene.name
     helper = bpy.data.scenes.get(name)
     if helper is None:
-        helper = scene.copy()
+        _copying_helper = True
+        try:
+            helper = scene.copy()
+        finally:
+            _copying_helper = False
         helper.name = name
         helper.use_fake_user = False
     if compat.compositor_trees_are_shared():
         old = compat.compositor_tree(helper)
-        copy = compat.compositor_tree(scene).copy()
+        _copying_helper = True
+        try:
+            copy = compat.compositor_tree(scene).copy()
+        finally:
+            _copying_helper = False
         copy.name = HELPER_PREFIX + scene.name
         compat.set_compositor_tree(helper, copy)
         if old is not None and old != compat.compositor_tree(scene) and old.users == 0:
             bpy.data.node_groups.remove(old)
-    # Output and colour settings follow the source scene's current ones.
+    # Size, output and colour settings follow the source scene's current ones.
+    for attribute in _RENDER_SETTINGS:
+        setattr(helper.render, attribute, getattr(scene.render, attribute))
     compat.copy_image_format(scene.render.image_settings, helper.render.image_settings)
     for attribute in ("view_transform", "look", "exposure", "gamma"):
         setattr(helper.view_settings, attribute, getattr(scene.view_settings, attribute))
     helper.display_settings.display_device = scene.display_settings.display_device
     return helper
+
+
+def is_copying_helper():
+    """True while the helper scene (or its tree) is being copied: its SSAO nodes share their
+    inner tree and AO image with the scene's."""
+    return _copying_helper
 
 
 def helper_scene_if_any(scene):

@@ -8,8 +8,8 @@ Ambient Occlusion (SSAO) node in the compositor and saves it as a .blend.
         [--output //render_####.png] [--ao-pass] [--radius 0.8]
 
 The compositor: Render Layers (Image, Depth, Normal) -> SSAO -> Composite (Group Output in 5.x);
-the SSAO node's AO output also goes to a Viewer. With --frames N the camera moves over frames
-1..N. The compositor is built the way of the running Blender through the add-on's own version
+the SSAO node's AO output also goes to a Viewer. With --frames N the camera moves and turns
+over frames 1..N, and each frame's camera is written too (OUT.camera.NNNN.json). The compositor is built the way of the running Blender through the add-on's own version
 shims (its compat module), which this also tests.
 """
 import argparse
@@ -95,10 +95,15 @@ def main():
         render.compositor_device = args.compositor_device
     scene.frame_start, scene.frame_end = 1, args.frames
     if args.frames > 1:
+        # The camera moves and turns: each frame's AO needs that frame's camera.
         camera.location.x -= 0.2
+        camera.rotation_euler.z -= 0.08
         camera.keyframe_insert("location", frame=1)
+        camera.keyframe_insert("rotation_euler", frame=1)
         camera.location.x += 0.4
+        camera.rotation_euler.z += 0.16
         camera.keyframe_insert("location", frame=args.frames)
+        camera.keyframe_insert("rotation_euler", frame=args.frames)
 
     tree = compat.ensure_compositor_tree(scene)
     tree.nodes.clear()
@@ -130,6 +135,12 @@ def main():
         tree.links.new(ssao.outputs["AO"], passes.inputs["SSAO"])
     out_prefix = os.path.splitext(os.path.abspath(args.out))[0]
     reference.write_json(out_prefix + ".camera.json", reference.camera_description(camera))
+    if args.frames > 1:  # and each frame's camera, as out_prefix.camera.NNNN.json
+        for frame in range(1, args.frames + 1):
+            scene.frame_set(frame)
+            reference.write_json(f"{out_prefix}.camera.{frame:04d}.json",
+                                 reference.camera_description(camera))
+        scene.frame_set(1)
     bpy.ops.wm.save_as_mainfile(filepath=os.path.abspath(args.out))
     print(f"build_ssao_scene: saved {args.out} ({args.engine}, {args.camera}, "
           f"{args.width}x{args.height}, {args.frames} frame(s))")

@@ -210,6 +210,12 @@ class AddonTest(unittest.TestCase):
             "SSAO_COMPOSITOR_EXPORT_DIR": os.path.join(folder, "export")})
         self.assertEqual(log.count("with AO"), 3, log)
         aos = self.assert_frames_are_beauty_times_ao(folder, 3)
+        # Each frame's AO is the command-line tool's on that frame's passes with that frame's
+        # camera (it turns: the wrong frame's camera rotates the normals).
+        for frame, ao in zip((1, 2, 3), aos):
+            cli = self.cli_ao(folder, os.path.join(folder, f"scene.camera.{frame:04d}.json"),
+                              frame)
+            np.testing.assert_allclose(ao, cli, atol=1e-5, err_msg=f"frame {frame}")
         self.assertGreater(float(np.abs(aos[0] - aos[2]).max()), 0.1, "the camera moves")
 
     def test_multilayer_output_holds_the_composite_with_ao(self):

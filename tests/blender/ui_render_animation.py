@@ -29,8 +29,7 @@ def addon_busy():
                     None)
     if handlers is None:
         raise RuntimeError("the ssao_compositor add-on is not loaded")
-    return bool(handlers._written_frames or handlers._pending_frames
-                or bpy.app.timers.is_registered(handlers._process_pending))
+    return bool(handlers._written_frames or handlers._pending_frames)
 
 
 def quit_blender(code):
