@@ -1,17 +1,20 @@
 # SPDX-License-Identifier: MIT
 """Every difference between Blender 3.4, 4.x and 5.x that the add-on meets, in one place.
-The rest of the add-on calls these and never tests versions or attributes itself.
+The rest of the add-on calls these and never tests versions or version-dependent attributes
+itself; here a difference is found by the attribute or type it concerns where one exists, by
+the version number only for a behaviour (compositor_cannot_export).
 
 Checked in Blender 3.4.1, 4.3.2 and 5.2.2 (docs/blender.md, "Blender versions")."""
 import bpy
 
 
-def compositor_tree(scene):
+def compositor_tree(scene, in_use_only=True):
     """The scene's compositing node tree: a node-group data-block in 5.0+
-    (scene.compositing_node_group), the scene's embedded scene.node_tree before."""
+    (scene.compositing_node_group), the scene's embedded scene.node_tree before, where
+    compositing can be off (scene.use_nodes): None then, unless in_use_only is False."""
     if hasattr(scene, "compositing_node_group"):
         return scene.compositing_node_group
-    return scene.node_tree if scene.use_nodes else None
+    return scene.node_tree if scene.use_nodes or not in_use_only else None
 
 
 def ensure_compositor_tree(scene):
@@ -147,6 +150,13 @@ def image_format(settings):
             settings.file_format == 'OPEN_EXR_MULTILAYER':
         return 'OPEN_EXR_MULTILAYER'
     return settings.file_format
+
+
+def is_movie(settings):
+    """A movie output format (5.x: media_type VIDEO; before: FFMPEG or AVI)."""
+    if getattr(settings, "media_type", None) == 'VIDEO':
+        return True
+    return settings.file_format in {'FFMPEG', 'AVI_JPEG', 'AVI_RAW'}
 
 
 FORMAT_ATTRIBUTES = ("media_type", "file_format", "color_mode", "color_depth", "exr_codec",

@@ -63,7 +63,7 @@ def compositor_trees():
     has the same name), helper scenes left out."""
     seen = set()
     for scene in bpy.data.scenes:
-        tree = compat.compositor_tree(scene)
+        tree = compat.compositor_tree(scene, in_use_only=False)
         if tree is None or tree.as_pointer() in seen or \
                 scene.name.startswith(HELPER_SCENE_PREFIX):
             continue

@@ -22,7 +22,7 @@ import time
 
 import bpy
 
-from . import compute, inner_tree, recomposite, saved_form
+from . import compat, compute, inner_tree, recomposite, saved_form
 from .compute import report
 
 _pending_frames = []    # UI: (scene name, frame) rendered, waiting for the main-thread timer
@@ -48,6 +48,17 @@ def _written_output(scene):
     candidates = [p for p in (render.frame_path(frame=scene.frame_current), still)
                   if os.path.isfile(p)]
     return max(candidates, key=os.path.getmtime) if candidates else None
+
+
+_movie_warned = set()
+
+
+def _warn_movie_once(scene):
+    if scene.name not in _movie_warned:
+        _movie_warned.add(scene.name)
+        report(f"scene '{scene.name}' renders to a movie, which cannot be written again: its "
+               "frames get the AO of the frame before. Render to image files (PNG, EXR) and "
+               "make the movie from them", error=True)
 
 
 def _recomposite_and_write(scene, frame, output, passes, layers):
@@ -90,10 +101,12 @@ def _on_render_post(scene, *_):
         _pending_frames.append((scene.name, scene.frame_current))  # for _process_pending
         return
     frame = scene.frame_current
+    if compat.is_movie(scene.render.image_settings):
+        _warn_movie_once(scene)
     # Headless, the scene's objects (the camera) still hold the frame the file was saved at.
     scene.frame_set(frame)
     aos = compute.compute_frame(scene, frame, _render_started)
-    if not aos:
+    if not aos or compat.is_movie(scene.render.image_settings):
         return
     passes = recomposite.passes_path(scene, frame)
     try:
@@ -114,7 +127,9 @@ def _on_render_write(scene, *_):
     if not bpy.app.background:
         # An animation in the UI: the Render Result holds this frame's passes only until the
         # next frame renders, so save them now (render thread) and finish after the job.
-        if compute.ssao_nodes(scene):
+        if compat.is_movie(scene.render.image_settings):
+            _warn_movie_once(scene)
+        elif compute.ssao_nodes(scene):
             output = _written_output(scene)
             passes = recomposite.passes_path(scene, frame)
             try:

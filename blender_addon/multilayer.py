@@ -18,6 +18,7 @@ MAGIC = 20000630
 NO_COMPRESSION, ZIPS_COMPRESSION, ZIP_COMPRESSION = 0, 2, 3
 LINES_PER_CHUNK = {NO_COMPRESSION: 1, ZIPS_COMPRESSION: 1, ZIP_COMPRESSION: 16}
 HALF, FLOAT = 1, 2
+MAX_PIXELS = 1 << 28  # 16384 x 16384: a larger data window is taken for a damaged header
 CODECS = {"NONE": NO_COMPRESSION, "ZIPS": ZIPS_COMPRESSION, "ZIP": ZIP_COMPRESSION}
 # Written again from the channels; any other attribute of the source is copied as it is.
 _REWRITTEN = {"channels", "compression", "dataWindow", "displayWindow", "lineOrder", "chunkCount"}
@@ -80,7 +81,8 @@ def _channels(raw):
 
 
 def _unzip(block, expected):
-    raw = np.frombuffer(zlib.decompress(block), np.uint8)
+    # Never more than the chunk can hold: a damaged chunk could inflate to gigabytes.
+    raw = np.frombuffer(zlib.decompressobj().decompress(block, expected + 1), np.uint8)
     if raw.size != expected:
         raise ExrError("corrupt ZIP chunk")
     # Undo the predictor (running sum of deltas - 128, mod 256), then the interleave.
@@ -107,15 +109,18 @@ def _read_part(data, path, attributes, offsets, multipart, planes):
     if attributes.get("type", ("", b"scanlineimage"))[1].rstrip(b"\0") != b"scanlineimage":
         raise ExrError(f"{path}: only scanline images are supported")
     channels = _channels(attributes["channels"][1])
-    compression = attributes["compression"][1][0]
-    if compression not in LINES_PER_CHUNK:
-        raise ExrError(f"{path}: compression {compression} is not supported (NONE, ZIP, ZIPS)")
+    compression = attributes["compression"][1][0]  # checked by _read
     x0, y0, x1, y1 = struct.unpack("<4i", attributes["dataWindow"][1])
     width, height = x1 - x0 + 1, y1 - y0 + 1
+    if width <= 0 or height <= 0 or width * height > MAX_PIXELS:
+        raise ExrError(f"{path}: a data window of {width} x {height} pixels")
     lines = LINES_PER_CHUNK[compression]
     line_bytes = sum(width * _DTYPES[t].itemsize for _, t in channels)
     for name, _ in channels:
-        planes[name] = np.empty((height, width), np.float32)
+        if name in planes:
+            raise ExrError(f"{path}: the channel {name} is in two parts")
+        planes[name] = np.zeros((height, width), np.float32)
+    filled = np.zeros(height, bool)
     skip = 4 if multipart else 0  # a multi-part file's chunks start with their part number
     for offset in offsets:
         if offset + skip + 8 > len(data):
@@ -134,6 +139,9 @@ def _read_part(data, path, attributes, offsets, multipart, planes):
                 dtype = _DTYPES[pixel_type]
                 planes[name][row] = np.frombuffer(block, dtype, width, at_block)
                 at_block += width * dtype.itemsize
+        filled[row0:row0 + count] = True
+    if not filled.all():
+        raise ExrError(f"{path}: {int((~filled).sum())} rows have no data")
 
 
 def read(path):
@@ -154,8 +162,14 @@ def _read(data, path):
         if "dataWindow" not in attributes or "compression" not in attributes:
             raise ExrError(f"{path}: the header has no dataWindow or compression")
         x0, y0, x1, y1 = struct.unpack("<4i", attributes["dataWindow"][1])
-        lines = LINES_PER_CHUNK.get(attributes["compression"][1][0], 1)
+        compression = attributes["compression"][1][0]
+        if compression not in LINES_PER_CHUNK:
+            raise ExrError(f"{path}: compression {compression} is not supported (NONE, ZIP, "
+                           "ZIPS)")
+        lines = LINES_PER_CHUNK[compression]
         chunks = (y1 - y0 + lines) // lines
+        if chunks <= 0 or chunks > MAX_PIXELS:
+            raise ExrError(f"{path}: a data window of {y1 - y0 + 1} rows")
         if at + 8 * chunks > len(data):
             raise ExrError(f"{path}: truncated offset table")
         offsets = struct.unpack_from(f"<{chunks}Q", data, at)
@@ -172,11 +186,17 @@ def _attribute(name, kind, value):
 def write(path, planes, attributes=None, half=False, codec="ZIP"):
     """Writes {channel name: (height, width) array, row 0 on top} as a single-part scanline
     EXR; `attributes` (as read() returns them) are copied but for the ones written anew. half:
-    16-bit channels (depth, named Z, stays 32-bit as Blender keeps it)."""
+    colour channels (R, G, B, A) in 16 bits, the others (depth, normals, vectors, AO's V) in 32,
+    as Blender writes a 16-bit multilayer file."""
     compression = CODECS.get(codec, ZIP_COMPRESSION)
     names = sorted(planes)
     height, width = planes[names[0]].shape
-    types = {n: FLOAT if not half or n.endswith(".Z") or n == "Z" else HALF for n in names}
+    for name in names:
+        if planes[name].shape != (height, width):
+            raise ExrError(f"{path}: channel {name} is {planes[name].shape[1]} x "
+                           f"{planes[name].shape[0]}, not {width} x {height}")
+    types = {n: HALF if half and n.rsplit(".", 1)[-1] in ("R", "G", "B", "A") else FLOAT
+             for n in names}
     chlist = b"".join(n.encode() + b"\0" + struct.pack("<iB3xii", types[n], 0, 1, 1)
                       for n in names) + b"\0"
     window = struct.pack("<4i", 0, 0, width - 1, height - 1)
@@ -212,12 +232,17 @@ def write(path, planes, attributes=None, half=False, codec="ZIP"):
         table.append(offset)
         offset += len(chunk)
     temporary = path + ".part"
-    with open(temporary, "wb") as f:
-        f.write(head)
-        f.write(struct.pack(f"<{len(table)}Q", *table))
-        for chunk in chunks:
-            f.write(chunk)
-    os.replace(temporary, path)
+    try:
+        with open(temporary, "wb") as f:
+            f.write(head)
+            f.write(struct.pack(f"<{len(table)}Q", *table))
+            for chunk in chunks:
+                f.write(chunk)
+        os.replace(temporary, path)
+    except BaseException:
+        if os.path.exists(temporary):
+            os.remove(temporary)
+        raise
 
 
 def rewrite(passes_path, composite_path, ao_layers, out_path, half=False, codec="ZIP"):

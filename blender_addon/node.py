@@ -13,7 +13,9 @@ VARIANT_PARAMETERS = {}
 
 
 def _on_parameter_changed(node, context):
-    handlers.parameter_changed(node, context.scene if context else None)
+    # The node's own scene (the context's may be another one showing a pinned tree).
+    handlers.parameter_changed(node, compute.scene_of_tree(node.id_data) or
+                               (context.scene if context else None))
 
 
 def _property_for(desc):

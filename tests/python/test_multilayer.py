@@ -5,6 +5,7 @@ what one writes the other reads back, for every codec and depth, single- and mul
 hostile files are refused with a message."""
 import os
 import shutil
+import struct
 import sys
 import tempfile
 import unittest
@@ -27,10 +28,29 @@ def sample_planes(height=37, width=53):
     return planes
 
 
+def _offset_table(data):
+    """Where the offset table of a file written by multilayer.write starts (its last header
+    attribute is screenWindowWidth, a float)."""
+    at = data.index(b"screenWindowWidth\0float\0")
+    return at + len(b"screenWindowWidth\0float\0") + 4 + 4 + 1
+
+
 def _with_bad_offsets(data):
     """The file with its first chunk offset pointing past the end."""
-    header_end = data.index(b"\0\0", data.index(b"screenWindowWidth")) + 2
-    return data[:header_end - 1] + (2 ** 40).to_bytes(8, "little") + data[header_end + 7:]
+    at = _offset_table(data)
+    return data[:at] + (2 ** 40).to_bytes(8, "little") + data[at + 8:]
+
+
+def _with_data_window(data, width, height):
+    """The file claiming a data window of width x height pixels."""
+    at = data.index(b"dataWindow\0box2i\0") + len(b"dataWindow\0box2i\0") + 4
+    return data[:at] + struct.pack("<4i", 0, 0, width - 1, height - 1) + data[at + 16:]
+
+
+def _with_first_offset_repeated(data):
+    """The file with its second chunk offset pointing at the first chunk (rows left empty)."""
+    at = _offset_table(data)
+    return data[:at + 8] + data[at:at + 8] + data[at + 16:]
 
 
 class MultilayerTest(unittest.TestCase):
@@ -53,9 +73,10 @@ class MultilayerTest(unittest.TestCase):
                     names, pixels = read_image(path)
                     self.assertEqual(sorted(names), sorted(self.planes))
                     for name, plane in self.planes.items():
-                        # half: 11-bit mantissa; depth (Z) stays 32-bit.
-                        tolerance = 0 if not half or name.endswith(".Z") else \
-                            float(np.abs(plane).max()) * 2 ** -10
+                        # half: colour channels in 16 bits (11-bit mantissa), the rest 32.
+                        colour = name.rsplit(".", 1)[-1] in "RGBA"
+                        tolerance = float(np.abs(plane).max()) * 2 ** -10 if half and colour \
+                            else 0
                         np.testing.assert_allclose(pixels[:, :, names.index(name)], plane,
                                                    rtol=0, atol=tolerance)
                     spec = oiio.ImageInput.open(path).spec()
@@ -94,14 +115,18 @@ class MultilayerTest(unittest.TestCase):
         multilayer.write(self.path("good.exr"), self.planes, codec="ZIP")
         with open(self.path("good.exr"), "rb") as f:
             data = f.read()
-        cases = {"empty": b"", "not_exr": b"P6\n1 1\n255\n\0\0\0",
-                 "truncated_header": data[:40], "truncated_data": data[:len(data) // 2],
-                 "bad_offsets": _with_bad_offsets(data)}
-        for name, content in cases.items():
+        cases = {"empty": (b"", "not an OpenEXR"),
+                 "not_exr": (b"P6\n1 1\n255\n\0\0\0", "not an OpenEXR"),
+                 "truncated_header": (data[:40], "truncated"),
+                 "truncated_data": (data[:len(data) // 2], "truncated"),
+                 "bad_offsets": (_with_bad_offsets(data), "truncated"),
+                 "huge_window": (_with_data_window(data, 1 << 24, 37), "data window"),
+                 "missing_rows": (_with_first_offset_repeated(data), "rows have no data")}
+        for name, (content, message) in cases.items():
             with self.subTest(name):
                 with open(self.path(name), "wb") as f:
                     f.write(content)
-                with self.assertRaises(multilayer.ExrError):
+                with self.assertRaisesRegex(multilayer.ExrError, message):
                     multilayer.read(self.path(name))
 
 
