@@ -61,12 +61,6 @@ def _warn_movie_once(scene):
                "make the movie from them", error=True)
 
 
-def _recomposite_and_write(scene, frame, output, passes, layers):
-    helper = recomposite.recomposite(scene, passes)
-    recomposite.write_output(scene, helper, output, passes, layers)
-    report(f"wrote {output} with AO")
-
-
 def _remove(path):
     try:
         os.remove(path)
@@ -152,7 +146,6 @@ def _on_render_write(scene, *_):
         # The helper's Render Result holds the re-composited frame.
         helper = recomposite.helper_scene_if_any(scene)
         recomposite.write_output(scene, helper, output, passes, layers)
-        report(f"wrote {output} with AO")
     except Exception as error:
         report(f"writing frame {frame} with AO failed: {error}", error=True)
     finally:
@@ -180,7 +173,8 @@ def _process_pending():
             scene.frame_set(frame)
             aos = compute.compute_frame(scene, frame, _render_started)
             if aos:
-                _recomposite_and_write(scene, frame, output, passes, ao_layers(aos))
+                helper = recomposite.recomposite(scene, passes)
+                recomposite.write_output(scene, helper, output, passes, ao_layers(aos))
         except Exception as error:
             report(f"frame {frame}: writing it with AO failed: {error}", error=True)
         finally:

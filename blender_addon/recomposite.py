@@ -178,8 +178,9 @@ def write_output(scene, helper, path, passes, ao_layers):
                                codec=scene.render.image_settings.exr_codec)
         finally:
             os.remove(composite_path)
-        return
-    bpy.data.images["Render Result"].save_render(path, scene=helper)
+    else:
+        bpy.data.images["Render Result"].save_render(path, scene=helper)
+    compute.report(f"wrote {path} with AO")
 
 
 def remove_helpers():
