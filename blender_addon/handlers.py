@@ -154,9 +154,17 @@ def _on_render_write(scene, *_):
 
 def _process_pending():
     """UI: main-thread work after a render (handlers run in the render thread there, where no
-    timer may be registered: this one polls, from register() on)."""
-    if bpy.app.is_job_running('RENDER') or not (_written_frames or _pending_frames):
-        return 0.2
+    timer may be registered: this one polls, from register() on, and must never raise, or
+    Blender drops it)."""
+    try:
+        if not bpy.app.is_job_running('RENDER') and (_written_frames or _pending_frames):
+            _finish_rendered_frames()
+    except Exception as error:
+        report(f"after the render: {error}", error=True)
+    return 0.2
+
+
+def _finish_rendered_frames():
     if _written_frames:
         # Outside a render handler the helper scene can go: the next one copies the compositor
         # as it is now (before 5.0 a scene's tree cannot be swapped, only copied with it).
@@ -184,7 +192,7 @@ def _process_pending():
     _pending_frames.clear()
     scene = bpy.data.scenes.get(last[0]) if last else None
     if scene is None:
-        return 0.2
+        return
     # The Render Result shows the last frame rendered; after an animation the scene is back
     # at its own frame: that frame's camera for the AO, then the scene as it was.
     current = scene.frame_current
@@ -203,7 +211,6 @@ def _process_pending():
             for node in compute.ssao_nodes(scene):
                 node.status = message
             report(message)
-    return 0.2
 
 
 _nudge = {"scene": None, "tries": 0, "composited": False}
