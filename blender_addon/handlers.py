@@ -217,23 +217,32 @@ _nudge = {"scene": None, "tries": 0, "composited": False}
 
 
 def nudge_until_composited(scene):
-    """Nudges the scene's SSAO nodes so that the UI compositor runs again, and once more when
-    no compositor job started within half a second: right after a short render the first
-    nudge can be lost (measured in 5.2.2 on a 0.5 s render: no job)."""
-    for node in compute.ssao_nodes(scene):
-        inner_tree.nudge(node)
+    """Nudges the scene's SSAO nodes so that the UI compositor runs again; then, when the
+    compositor jobs of the moment are over, once more (one of them may have started before the
+    new AO was in place: measured in 3.4 under load), and again while no job starts (right
+    after a short render the nudge can be lost: measured in 5.2.2 after a 0.5 s render)."""
+    _nudge_nodes(scene)
     _nudge.update(scene=scene.name, tries=0, composited=False)
     if _compositor_editor_open() and not bpy.app.timers.is_registered(_check_nudge):
-        bpy.app.timers.register(_check_nudge, first_interval=0.5)
+        bpy.app.timers.register(_check_nudge, first_interval=0.3)
+
+
+def _nudge_nodes(scene):
+    for node in compute.ssao_nodes(scene):
+        inner_tree.nudge(node)
 
 
 def _check_nudge():
     scene = bpy.data.scenes.get(_nudge["scene"] or "")
-    if _nudge["composited"] or scene is None or _nudge["tries"] >= 4:
+    if scene is None or _nudge["tries"] >= 4:
+        return None
+    if bpy.app.is_job_running('COMPOSITE'):
+        return 0.2
+    if _nudge["tries"] > 0 and _nudge["composited"]:
         return None
     _nudge["tries"] += 1
-    for node in compute.ssao_nodes(scene):
-        inner_tree.nudge(node)
+    _nudge["composited"] = False
+    _nudge_nodes(scene)
     return 0.5
 
 
