@@ -31,17 +31,19 @@ ssao_param_desc string_param(const char* name, const char* def, const char* choi
 const std::vector<ssao_param_desc>& table() {
   static const std::vector<ssao_param_desc> params = {
       // --- algorithm ---
-      string_param("variant", "hemisphere", "horizon|hemisphere|sphere",
+      string_param("variant", "hemisphere", "horizon|hemisphere|sphere|volumetric",
                    "horizon: horizon-based slices with a visibility bitmask (GTAO); hemisphere: "
-                   "normal-oriented hemisphere kernel; sphere: Crysis sphere kernel (depth only)"),
+                   "normal-oriented hemisphere kernel; sphere: Crysis sphere kernel (depth only); "
+                   "volumetric: line-integral obscurance of a sphere along view rays (depth "
+                   "only)"),
       float_param("radius", 1.0, 1e-6, 1e9, "scene units",
                   "distance within which geometry occludes, as Cycles' AO distance"),
       string_param("quality", "medium", "low|medium|high|ultra",
                    "sample counts of the variant (samples, slices, steps) that are left at 0; "
                    "medium is the measured balance of time and error"),
       int_param("samples", 0, 0, 1024, "directions per pixel",
-                "hemisphere: kernel directions per pixel; sphere: points per pixel; 0: from "
-                "quality"),
+                "hemisphere: kernel directions per pixel; sphere: points per pixel; volumetric: "
+                "view rays per pixel; 0: from quality"),
       int_param("slices", 0, 0, 64, "slices per pixel",
                 "horizon: screen-space lines through each pixel; 0: from quality"),
       int_param("steps", 0, 0, 64, "samples per direction",
@@ -59,7 +61,9 @@ const std::vector<ssao_param_desc>& table() {
           "thickness", 0.5, 0.01, 100.0, "fraction of radius",
           "assumed thickness of surfaces: horizon: an occluder spans this far behind the visible "
           "surface; hemisphere: a sample this far behind the visible surface counts fully, "
-          "fading out at twice the distance (range check against halos)"),
+          "fading out at twice the distance (range check against halos); volumetric: a ray "
+          "whose visible surface is this far in front of the sphere counts fully, fading out "
+          "at twice the distance"),
       string_param("sphere_mode", "normalized", "normalized|classic",
                    "sphere variant: classic reads about 0.5 on a flat wall; normalized maps an "
                    "unoccluded flat surface to 1"),

@@ -68,7 +68,7 @@ Camera orthographic_like_perspective() {
 
 TEST(Analytic, FacingPlaneIsUnoccluded) {
   const Camera cam = perspective();
-  for (const char* variant : {"horizon", "hemisphere", "sphere"}) {
+  for (const char* variant : {"horizon", "hemisphere", "sphere", "volumetric"}) {
     for (bool normals : {true, false}) {
       Scene s = facing_plane(cam);
       const auto ao = compute_ao(s, cam, 0.5, variant, normals);
@@ -82,7 +82,7 @@ TEST(Analytic, FacingPlaneIsUnoccluded) {
 
 TEST(Analytic, TiltedPlaneIsUnoccluded) {
   const Camera cam = perspective();
-  for (const char* variant : {"horizon", "hemisphere", "sphere"}) {
+  for (const char* variant : {"horizon", "hemisphere", "sphere", "volumetric"}) {
     for (bool normals : {true, false}) {
       Scene s = tilted_plane(cam);
       const auto ao = compute_ao(s, cam, 0.5, variant, normals);
@@ -181,6 +181,72 @@ TEST(Analytic, SphereDarkensTheCornerToHalfAtTheCrease) {
   // samples nearest the walls.
   EXPECT_NEAR(crease.mean, 0.5, 0.15);
   EXPECT_GE(walls.mean, 0.97);
+}
+
+// The volumetric obscurance of a point on a wall of the concave corner, d radii from the crease:
+// twice the part of the unit ball around it in front of both walls (clamped to 1), integrated on
+// a grid; 1/2 at the crease, 1 from one radius on.
+double corner_volumetric_closed_form(double d) {
+  const V3 n1 = normalized({1, 0, 1}), n2 = normalized({-1, 0, 1}), along = normalized({-1, 0, 1});
+  const int n = 48;
+  long inside = 0, empty = 0;
+  for (int i = 0; i < n; ++i) {
+    for (int j = 0; j < n; ++j) {
+      for (int k = 0; k < n; ++k) {
+        const V3 r{(i + 0.5) / n * 2 - 1, (j + 0.5) / n * 2 - 1, (k + 0.5) / n * 2 - 1};
+        if (r.x * r.x + r.y * r.y + r.z * r.z > 1) continue;
+        ++inside;
+        const V3 q{d * along.x + r.x, d * along.y + r.y, d * along.z + r.z};
+        const double a = n1.x * q.x + n1.y * q.y + n1.z * q.z;
+        const double b = n2.x * q.x + n2.y * q.y + n2.z * q.z;
+        if (a > 0 && b > 0) ++empty;
+      }
+    }
+  }
+  return std::min(1.0, 2.0 * double(empty) / double(inside));
+}
+
+TEST(Analytic, VolumetricMatchesTheCornersClosedForm) {
+  for (const Camera& cam : {perspective(), orthographic_like_perspective()}) {
+    Scene s = concave_corner(cam);
+    // No fall-off (it lets the far wall's rays fade out), many rays, no blur: the estimate
+    // itself against the ball's volume in front of the walls.
+    const auto ao = compute_ao(s, cam, 1.0, "volumetric", false, [](Job& j) {
+      j.set("samples", 128);
+      j.set("thickness", 100.0);
+      j.set("denoise", "none");
+    });
+    double previous = 0.0;
+    for (double band = 0.0; band < 1.25; band += 0.25) {
+      const Stats st = stats_over(s, ao, [&](int x, int y) {
+        const double d = distance_to_crease(s, x, y);
+        return d >= band && d < band + 0.25;
+      });
+      ASSERT_GT(st.count, 20) << "band " << band;
+      const double expected =
+          0.5 * (corner_volumetric_closed_form(band) + corner_volumetric_closed_form(band + 0.25));
+      EXPECT_NEAR(st.mean, expected, 0.05) << "band " << band << (cam.ortho ? " ortho" : "");
+      EXPECT_GE(st.mean, previous - 0.01) << "band " << band;
+      previous = st.mean;
+    }
+    // The fall-off only ever lightens: rays hidden by a surface in front of the sphere fade out.
+    const auto with_falloff = compute_ao(s, cam, 1.0, "volumetric", false);
+    const Stats walls = stats_over(s, with_falloff,
+                                   [&](int x, int y) { return distance_to_crease(s, x, y) > 1.2; });
+    EXPECT_GE(walls.mean, 0.98);
+  }
+}
+
+TEST(Analytic, ConvexRidgeIsNotDarkenedByVolumetric) {
+  // At a convex ridge only a quarter of the sphere is solid: the doubled empty part is clamped
+  // to 1 (the ridge is not brightened, and not darkened).
+  const Camera cam = perspective();
+  const V3 ridge{0, 0, -5};
+  Scene s = ray_cast(cam, {{{ridge, normalized({1, 0, 1})}, {ridge, normalized({-1, 0, 1})}}});
+  const auto ao = compute_ao(s, cam, 1.0, "volumetric", false);
+  const Stats st = stats_over(s, ao, everywhere);
+  EXPECT_GT(st.count, s.width * s.height / 2);
+  EXPECT_GE(st.min, 0.97);
 }
 
 TEST(Analytic, ConvexRidgeIsNotDarkenedByHemisphere) {

@@ -11,10 +11,11 @@ namespace ssao {
 extern const VariantInfo kHorizonVariant;
 extern const VariantInfo kHemisphereVariant;
 extern const VariantInfo kSphereVariant;
+extern const VariantInfo kVolumetricVariant;
 
 const std::vector<VariantInfo>& variant_registry() {
   static const std::vector<VariantInfo> variants = {kHorizonVariant, kHemisphereVariant,
-                                                    kSphereVariant};
+                                                    kSphereVariant, kVolumetricVariant};
   return variants;
 }
 
