@@ -31,11 +31,12 @@ ssao_param_desc string_param(const char* name, const char* def, const char* choi
 const std::vector<ssao_param_desc>& table() {
   static const std::vector<ssao_param_desc> params = {
       // --- algorithm ---
-      string_param("variant", "hemisphere", "horizon|hemisphere|sphere|volumetric",
+      string_param("variant", "hemisphere", "horizon|hemisphere|sphere|volumetric|unsharp",
                    "horizon: horizon-based slices with a visibility bitmask (GTAO); hemisphere: "
                    "normal-oriented hemisphere kernel; sphere: Crysis sphere kernel (depth only); "
                    "volumetric: line-integral obscurance of a sphere along view rays (depth "
-                   "only)"),
+                   "only); unsharp: depth unsharp masking, the local mean depth against the "
+                   "pixel's (depth only)"),
       float_param("radius", 1.0, 1e-6, 1e9, "scene units",
                   "distance within which geometry occludes, as Cycles' AO distance"),
       string_param("quality", "medium", "low|medium|high|ultra",

@@ -68,7 +68,7 @@ Camera orthographic_like_perspective() {
 
 TEST(Analytic, FacingPlaneIsUnoccluded) {
   const Camera cam = perspective();
-  for (const char* variant : {"horizon", "hemisphere", "sphere", "volumetric"}) {
+  for (const char* variant : {"horizon", "hemisphere", "sphere", "volumetric", "unsharp"}) {
     for (bool normals : {true, false}) {
       Scene s = facing_plane(cam);
       const auto ao = compute_ao(s, cam, 0.5, variant, normals);
@@ -82,7 +82,7 @@ TEST(Analytic, FacingPlaneIsUnoccluded) {
 
 TEST(Analytic, TiltedPlaneIsUnoccluded) {
   const Camera cam = perspective();
-  for (const char* variant : {"horizon", "hemisphere", "sphere", "volumetric"}) {
+  for (const char* variant : {"horizon", "hemisphere", "sphere", "volumetric", "unsharp"}) {
     for (bool normals : {true, false}) {
       Scene s = tilted_plane(cam);
       const auto ao = compute_ao(s, cam, 0.5, variant, normals);
@@ -247,6 +247,51 @@ TEST(Analytic, ConvexRidgeIsNotDarkenedByVolumetric) {
   const Stats st = stats_over(s, ao, everywhere);
   EXPECT_GT(st.count, s.width * s.height / 2);
   EXPECT_GE(st.min, 0.97);
+}
+
+TEST(Analytic, UnsharpDarkensTheCreaseAndKeepsItsLookAtAnyResolution) {
+  // Viewed head-on, the walls of the corner recede at 45 degrees: around the crease the depth
+  // falls by |x|, and a box of half-width one radius averages half a radius nearer: AO 1/2.
+  for (const Camera& base : {perspective(), orthographic_like_perspective()}) {
+    Camera twice = base;
+    twice.width *= 2, twice.height *= 2;
+    std::vector<double> bands[2];
+    for (int i = 0; i < 2; ++i) {
+      const Camera& cam = i == 0 ? base : twice;
+      Scene s = concave_corner(cam);
+      const auto ao = compute_ao(s, cam, 1.0, "unsharp", false, [](Job& j) {
+        j.set("denoise", "none");
+        j.set("resolution", "full");
+      });
+      for (double band = 0.0; band < 1.5; band += 0.25) {
+        const Stats st = stats_over(s, ao, [&](int x, int y) {
+          const double d = distance_to_crease(s, x, y);
+          return d >= band && d < band + 0.25;
+        });
+        ASSERT_GT(st.count, 20) << "band " << band;
+        bands[i].push_back(st.mean);
+      }
+      EXPECT_NEAR(bands[i][0], 0.55, 0.1) << (cam.ortho ? "ortho" : "persp");
+      for (size_t b = 1; b < bands[i].size(); ++b) EXPECT_GE(bands[i][b], bands[i][b - 1] - 0.01);
+      EXPECT_GE(bands[i].back(), 0.98);
+    }
+    // The box follows the radius in scene units: twice the pixels, the same look.
+    for (size_t b = 0; b < bands[0].size(); ++b) {
+      EXPECT_NEAR(bands[0][b], bands[1][b], 0.03) << "band " << b;
+    }
+  }
+}
+
+TEST(Analytic, ConvexRidgeIsNotDarkenedByUnsharp) {
+  // Around a ridge the surroundings are deeper than the pixel: no deficit, AO 1 (not
+  // brightened: the mask only darkens).
+  const Camera cam = perspective();
+  const V3 ridge{0, 0, -5};
+  Scene s = ray_cast(cam, {{{ridge, normalized({1, 0, 1})}, {ridge, normalized({-1, 0, 1})}}});
+  const auto ao = compute_ao(s, cam, 1.0, "unsharp", false);
+  const Stats st = stats_over(s, ao, everywhere);
+  EXPECT_GT(st.count, s.width * s.height / 2);
+  EXPECT_GE(st.min, 0.99);
 }
 
 TEST(Analytic, ConvexRidgeIsNotDarkenedByHemisphere) {

@@ -12,10 +12,11 @@ extern const VariantInfo kHorizonVariant;
 extern const VariantInfo kHemisphereVariant;
 extern const VariantInfo kSphereVariant;
 extern const VariantInfo kVolumetricVariant;
+extern const VariantInfo kUnsharpVariant;
 
 const std::vector<VariantInfo>& variant_registry() {
-  static const std::vector<VariantInfo> variants = {kHorizonVariant, kHemisphereVariant,
-                                                    kSphereVariant, kVolumetricVariant};
+  static const std::vector<VariantInfo> variants = {
+      kHorizonVariant, kHemisphereVariant, kSphereVariant, kVolumetricVariant, kUnsharpVariant};
   return variants;
 }
 
