@@ -65,6 +65,7 @@ LIBRARY_FULL = [
     ("volumetric", "quality=low", ["variant=volumetric", "quality=low"]),
     ("volumetric", "quality=medium", ["variant=volumetric"]),
     ("volumetric", "quality=ultra", ["variant=volumetric", "quality=ultra"]),
+    ("unsharp", "default", ["variant=unsharp"]),
 ]
 LIBRARY_QUICK = [
     ("hemisphere", "default", []),
@@ -353,7 +354,7 @@ def series_name(row):
     """The curve a library row belongs to: its variant, plus any setting other than the sample
     count ("hemisphere", "hemisphere steps=3", "sphere classic"), so that a curve varies the
     samples only. Other methods are one curve each."""
-    if row["method"] not in ("hemisphere", "sphere", "horizon", "volumetric"):
+    if row["method"] not in ("hemisphere", "sphere", "horizon", "volumetric", "unsharp"):
         return row["method"]
     extra = [part for part in row["setting"].split(",")
              if part != "default"
@@ -369,7 +370,7 @@ def plot_speed_error(path, rows, truth):
     lines = (len(scenes) + columns - 1) // columns
     fig, axes = plt.subplots(lines, columns, figsize=(5.2 * columns, 4.0 * lines), squeeze=False)
     styles = {"hemisphere": ("C0", "o"), "sphere": ("C1", "s"), "cycles": ("C3", "^"),
-              "horizon": ("C5", "P"), "volumetric": ("C6", "X"),
+              "horizon": ("C5", "P"), "volumetric": ("C6", "X"), "unsharp": ("C7", "*"),
               "seed-hemisphere": ("C2", "D"), "seed-sphere": ("C4", "v"),
               "raymarch": ("C5", "P")}
     for ax, scene in zip(axes.flat, scenes):
