@@ -32,20 +32,26 @@ def passes_path(scene, frame):
 
 def save_passes(scene, path):
     """Writes every pass of `scene`'s Render Result (and its Composite) to a 32-bit multilayer
-    EXR. save_render takes the render of the scene it is given, with that scene's output
-    settings: switch them briefly."""
+    EXR."""
+    os.makedirs(os.path.dirname(path), exist_ok=True)
+    _save_render_as(scene, path, 'OPEN_EXR_MULTILAYER', color_depth='32', codec='ZIP')
+
+
+def _save_render_as(scene, path, file_format, **settings):
+    """Saves `scene`'s Render Result to `path` in the given format. save_render takes the render
+    of the scene it is given, with that scene's output settings: switch them briefly."""
     result = bpy.data.images.get("Render Result")
     if result is None:
         raise RuntimeError("no Render Result")
-    os.makedirs(os.path.dirname(path), exist_ok=True)
-    settings = scene.render.image_settings
-    saved = {a: getattr(settings, a) for a in compat.FORMAT_ATTRIBUTES if hasattr(settings, a)}
+    image_settings = scene.render.image_settings
+    saved = {a: getattr(image_settings, a) for a in compat.FORMAT_ATTRIBUTES
+             if hasattr(image_settings, a)}
     try:
-        compat.set_image_format(settings, 'OPEN_EXR_MULTILAYER', color_depth='32', codec='ZIP')
+        compat.set_image_format(image_settings, file_format, **settings)
         result.save_render(path, scene=scene)
     finally:
-        for attribute, value in saved.items():
-            setattr(settings, attribute, value)
+        for attribute, value in saved.items():  # media_type first: it decides file_format's
+            setattr(image_settings, attribute, value)
 
 
 def helper_scene(scene):
@@ -165,13 +171,8 @@ def write_output(scene, helper, path, passes, ao_layers):
     composite (each scene has its own Render Result: the new one is the helper's)."""
     if compat.image_format(scene.render.image_settings) == 'OPEN_EXR_MULTILAYER':
         composite_path = path + ".composite.exr"
-        settings = helper.render.image_settings
-        try:
-            compat.set_image_format(settings, 'OPEN_EXR', color_depth='32', codec='NONE',
-                                    color_mode='RGBA')
-            bpy.data.images["Render Result"].save_render(composite_path, scene=helper)
-        finally:
-            compat.copy_image_format(scene.render.image_settings, settings)
+        _save_render_as(helper, composite_path, 'OPEN_EXR', color_depth='32', codec='NONE',
+                        color_mode='RGBA')
         try:
             multilayer.rewrite(passes, composite_path, ao_layers, path,
                                half=scene.render.image_settings.color_depth == '16',

@@ -74,13 +74,13 @@ class Volumetric final : public Variant {
       // Mirror-image rays: on a tilted surface their errors cancel. A pair counts only when
       // both rays are in front of the camera.
       Ray rays[2];
-      bool inside = true;
-      for (int m = 0; m < 2 && inside; ++m) {
+      bool in_front = true;
+      for (int m = 0; m < 2 && in_front; ++m) {
         const Vec3 offset = (side_u * disk[m].x + side_v * disk[m].y) * spread;
-        inside = camera.orthographic() ? orthographic_ray(f, p, offset, rays[m])
-                                       : perspective_ray(f, p, axis + offset, rays[m]);
+        in_front = camera.orthographic() ? orthographic_ray(f, p, offset, rays[m])
+                                         : perspective_ray(f, p, axis + offset, rays[m]);
       }
-      if (!inside) continue;
+      if (!in_front) continue;
       for (const Ray& ray : rays) add_ray(ray, solid, total);
     }
     if (!(total > 0.0f)) return 1.0f;
@@ -105,7 +105,7 @@ class Volumetric final : public Variant {
     const float along = dot(d, p);
     const float discriminant = along * along - (dot(p, p) - radius_ * radius_);
     if (!(discriminant > 0.0f)) {
-      ray.weight = 0.0f;  // grazes the sphere: nothing to measure, but inside the image
+      ray.weight = 0.0f;  // grazes the sphere: nothing to measure
     } else {
       const float root = std::sqrt(discriminant);
       ray.enter = along - root, ray.leave = along + root;
