@@ -11,6 +11,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <limits>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -127,14 +128,15 @@ std::string include_folder() {
   std::string tried;
   for (const fs::path& candidate : candidates) {
     if (fs::is_regular_file(candidate / "ssao_depth_post.inc", ec) &&
-        fs::is_regular_file(candidate / "ssao_depth_pre.inc", ec)) {
+        fs::is_regular_file(candidate / "ssao_depth_pre.inc", ec) &&
+        fs::is_regular_file(candidate / "ssao_ambient_post.inc", ec)) {
       return fs::absolute(candidate).lexically_normal().string();
     }
     tried += (tried.empty() ? "" : ", ") + in_quotes(candidate.string());
   }
   throw ssao_io::Error(
-      "cannot find povray-ssao's include files ssao_depth_pre.inc and "
-      "ssao_depth_post.inc (looked in " +
+      "cannot find povray-ssao's include files ssao_depth_pre.inc, "
+      "ssao_depth_post.inc and ssao_ambient_post.inc (looked in " +
       tried + ")");
 }
 
@@ -163,6 +165,9 @@ struct AoInputs {
   std::vector<float> planar;   // along the view axis; +inf on background
   std::vector<float> normals;  // libssao camera space, 3 per pixel, or empty
   bool planar_input = false;   // give libssao the planar depth (orthographic, planar files)
+  std::vector<float> ambient;  // R, G, B, 0 per pixel in the scene's working space, or empty:
+                               // AO darkens only this part of the beauty
+  double working_gamma = 1.0;  // the scene's assumed_gamma: beauty = working value ^ gamma
   ResolvedCamera camera;
 };
 
@@ -266,40 +271,42 @@ double compute_and_write(const Options& o, AoInputs& in, const Reporter& report)
   if (!in.normals.empty()) job.set("normal_space", "camera");
   ssao_io::apply_params(job, o.params);
 
-  if (!o.param("radius")) {
-    double radius = 0.0;
-    std::string rule;
-    if (in.camera.orthographic) {
-      radius = 0.05 * length(in.camera.right);
-      rule = "5% of the view width " + std::to_string(length(in.camera.right));
-    } else {
-      const DepthStats stats = depth_stats(in.radial);
-      if (stats.geometry > 0) {
-        radius = 0.05 * stats.median;
-        char buffer[64];
-        std::snprintf(buffer, sizeof buffer, "%.6g", stats.median);
-        rule = std::string("5% of the median depth ") + buffer;
-      }
-    }
-    if (radius > 0.0) {
-      job.set("radius", radius);
-      report.progress("radius %.6g scene units (%s; --radius to change)", radius, rule.c_str());
-    }
-  }
-
   const size_t count = static_cast<size_t>(in.width) * static_cast<size_t>(in.height);
   std::vector<float> ao(count, 1.0f);
   std::vector<float> composite(count * 4, 0.0f);
   std::vector<float>& depth = in.planar_input ? in.planar : in.radial;
   job.set_image("depth", depth.data(), in.width, in.height, 1);
   if (!in.normals.empty()) job.set_image("normal", in.normals.data(), in.width, in.height, 3);
-  job.set_image("beauty", in.beauty.data(), in.width, in.height, 4);
+  // In ambient mode the composite is made in the scene's working space, where the ambient term
+  // adds to the rest of the light: beauty^(1/gamma) - (1 - AO) ambient, then ^gamma again.
+  const bool gamma = !in.ambient.empty() && in.working_gamma != 1.0;
+  std::vector<float> working;
+  if (gamma) {
+    working = in.beauty;
+    for (size_t p = 0; p < count; ++p) {
+      for (size_t c = 0; c < 3; ++c) {
+        float& v = working[p * 4 + c];
+        if (v > 0.0f) v = static_cast<float>(std::pow(v, 1.0 / in.working_gamma));
+      }
+    }
+  }
+  job.set_image("beauty", gamma ? working.data() : in.beauty.data(), in.width, in.height, 4);
+  if (!in.ambient.empty()) job.set_image("ambient", in.ambient.data(), in.width, in.height, 4);
   job.set_image("composite", composite.data(), in.width, in.height, 4);
   job.set_image("ao", ao.data(), in.width, in.height, 1);
   job.set_progress(&progress_callback, nullptr);
+  if (!o.param("radius")) {
+    double radius = 0.0;
+    if (ssao_job_auto_radius(job.get(), &radius) == SSAO_OK) {
+      job.set("radius", radius);
+      report.progress("radius %.4g scene units (10%% of the view's width%s; --radius to change)",
+                      radius, in.camera.orthographic ? "" : " at the median depth");
+    }
+  }
 
-  report.begin("AO (%s, normals %s)... ", job.settings_summary().c_str(),
-               in.normals.empty() ? "from depth" : "from the normal pass");
+  report.begin("AO (%s, normals %s, %s)... ", job.settings_summary().c_str(),
+               in.normals.empty() ? "from depth" : "from the normal pass",
+               in.ambient.empty() ? "applied to the whole image" : "applied to the ambient light");
   const auto start = Clock::now();
   const ssao_status status = ssao_job_run(job.get());
   const double seconds = seconds_since(start);
@@ -308,6 +315,14 @@ double compute_and_write(const Options& o, AoInputs& in, const Reporter& report)
     throw ssao_io::Error("interrupted; nothing written");
   }
   ssao_io::check_status(status, "SSAO failed");
+  if (gamma) {
+    for (size_t p = 0; p < count; ++p) {
+      for (size_t c = 0; c < 3; ++c) {
+        float& v = composite[p * 4 + c];
+        if (v > 0.0f) v = static_cast<float>(std::pow(v, in.working_gamma));
+      }
+    }
+  }
   double sum = 0.0;
   size_t geometry = 0;
   for (size_t p = 0; p < count; ++p) {
@@ -321,7 +336,14 @@ double compute_and_write(const Options& o, AoInputs& in, const Reporter& report)
   return seconds;
 }
 
-// One povray run in the scene's folder with povray-ssao's includes on the library path.
+// A povray run under way: what it renders, where its image and log go.
+struct Render {
+  std::string what;  // "depth pass", for messages
+  std::string output, log;
+  std::unique_ptr<RunningProcess> process;
+};
+
+// povray runs in the scene's folder with povray-ssao's includes on the library path.
 struct Povray {
   std::string executable;
   std::string scene_folder;
@@ -330,13 +352,16 @@ struct Povray {
   const ScratchFolder* scratch = nullptr;
   bool keep = false;
 
-  double render(const std::string& what, const std::string& name, const std::string& wrapper,
-                int width, int height, const std::vector<std::string>& extra) const {
-    const std::string output = scratch->file(name + ".exr");
-    const std::string log = scratch->file(name + ".log");
+  // Starts rendering `wrapper` to <name>.exr; finish() waits for it.
+  Render start(const std::string& what, const std::string& name, const std::string& wrapper,
+               int width, int height, const std::vector<std::string>& extra) const {
+    Render render;
+    render.what = what;
+    render.output = scratch->file(name + ".exr");
+    render.log = scratch->file(name + ".log");
     std::vector<std::string> args = user_options;
     args.push_back("+I" + scratch->file(wrapper));
-    args.push_back("+O" + output);
+    args.push_back("+O" + render.output);
     args.push_back("+W" + std::to_string(width));
     args.push_back("+H" + std::to_string(height));
     args.push_back("-D");
@@ -346,7 +371,7 @@ struct Povray {
     args.push_back("+L" + include_folder);
     args.insert(args.end(), extra.begin(), extra.end());
     {
-      FILE* file = std::fopen(log.c_str(), "w");
+      FILE* file = std::fopen(render.log.c_str(), "w");
       if (file) {
         std::fprintf(file, "povray-ssao: %s", executable.c_str());
         for (const std::string& arg : args) std::fprintf(file, " %s", arg.c_str());
@@ -354,19 +379,35 @@ struct Povray {
         std::fclose(file);
       }
     }
-    const RenderResult result = run_process(executable, args, scene_folder, log);
+    render.process =
+        std::make_unique<RunningProcess>(executable, args, scene_folder, render.log, render.output);
+    return render;
+  }
+
+  // Waits for the run; returns its wall-clock seconds. Throws with POV-Ray's last messages when
+  // it failed or wrote no image.
+  double finish(Render& render) const {
+    // The image is complete once POV-Ray closes it; its shutdown after that is not waited for.
+    const RenderResult result = render.process->wait_for_output();
+    if (result.output_written) return result.seconds;
     std::error_code ec;
-    if (result.exit_status != 0 || !fs::is_regular_file(output, ec)) {
-      std::string message = "POV-Ray failed on the " + what;
+    if (result.exit_status != 0 || !fs::is_regular_file(render.output, ec)) {
+      std::string message = "POV-Ray failed on the " + render.what;
       message += result.exit_status != 0
                      ? " (exit status " + std::to_string(result.exit_status) + ")"
                      : " (no image written)";
-      message += ". Its last messages:\n" + povray_error_lines(log);
+      message += ". Its last messages:\n" + povray_error_lines(render.log);
       if (!keep) message += "(--keep DIR keeps the wrappers and the full logs)";
       while (!message.empty() && message.back() == '\n') message.pop_back();
       throw ssao_io::Error(message);
     }
     return result.seconds;
+  }
+
+  double render(const std::string& what, const std::string& name, const std::string& wrapper,
+                int width, int height, const std::vector<std::string>& extra) const {
+    Render running = start(what, name, wrapper, width, height, extra);
+    return finish(running);
   }
 };
 
@@ -545,113 +586,41 @@ void run_render(const Options& o) {
   write_wrappers(scratch.path(), scene_name, reading.camera);
   const std::vector<std::string> data_pass = {"+Q9", "-A", "-UA"};
 
-  // 1. The pre-pass: the depth range, for the fog distances.
-  FogDistances distances;
-  double prepass_seconds = 0.0;
-  if (o.fog_distances) {
-    distances = *o.fog_distances;
-  } else {
-    const int pw = std::min(width, std::clamp(width / 8, 16, 80));
-    const int ph =
-        std::max(1, static_cast<int>(std::lround(static_cast<double>(pw) * height / width)));
-    report.begin("depth-range pre-pass (%dx%d)... ", pw, ph);
-    std::vector<std::string> extra = data_pass;
-    for (const std::string& d : fog_declares(prepass_distances())) extra.push_back(d);
-    prepass_seconds = povray.render("depth-range pre-pass", "prepass", "depth.pov", pw, ph, extra);
-    const ssao_io::Image image = ssao_io::read_image(scratch.file("prepass.exr"));
-    const DepthStats stats =
-        depth_stats(decode_fog(image, prepass_distances(), scratch.file("prepass.exr")));
-    distances = choose_distances(stats);
-    if (stats.geometry == 0) {
-      report.end("%.2f s", prepass_seconds);
-      report.warning(
-          "the pre-pass saw no geometry (every ray missed); fog distances "
-          "D1 = 10, D2 = 100");
-    } else {
-      report.end("%.2f s: depths %.4g .. %.4g, median %.4g, 99%% below %.4g -> %s", prepass_seconds,
-                 stats.min, stats.max, stats.median, stats.p99, describe(distances).c_str());
+  // What AO darkens: the ambient term when the scene has one that can be rendered apart.
+  bool ambient_pass = !o.depth_only && o.apply_to != "beauty";
+  if (ambient_pass) {
+    std::string why_not;
+    if (scan.uses_radiosity && (scan.version == 0.0 || scan.version >= 3.7)) {
+      why_not =
+          "the scene uses radiosity, which replaces the ambient term in POV-Ray 3.7 (there is no "
+          "ambient light to darken)";
+    } else if (!scan.ambient_light_problem.empty()) {
+      why_not =
+          "povray-ssao cannot read the scene's ambient_light (" + scan.ambient_light_problem + ")";
+    }
+    if (!why_not.empty()) {
+      if (o.apply_to == "ambient") throw ssao_io::Error("--apply-to ambient: " + why_not);
+      report.progress("AO darkens the whole image: %s", why_not.c_str());
+      ambient_pass = false;
     }
   }
 
-  // 2. The beauty, with the user's settings.
+  // Every pass is started at once: POV-Ray spends about 0.65 s of each run waiting (start-up and
+  // its message polling), which overlaps, and the 2 cores share the rendering.
   AoInputs in;
   in.width = width;
   in.height = height;
   in.camera = reading.camera;
-  double beauty_seconds = 0.0;
+  Render beauty_render, ambient_render, normal_render;
   if (!o.depth_only) {
-    report.begin("rendering beauty (%dx%d)... ", width, height);
-    beauty_seconds = povray.render("beauty", "beauty", "beauty.pov", width, height, {});
-    report.end("%.2f s", beauty_seconds);
-    const ssao_io::Image beauty = ssao_io::read_image(scratch.file("beauty.exr"));
-    if (beauty.width != width || beauty.height != height) {
-      throw ssao_io::Error("POV-Ray rendered the beauty at " + std::to_string(beauty.width) + "x" +
-                           std::to_string(beauty.height) + " instead of " + std::to_string(width) +
-                           "x" + std::to_string(height) +
-                           " (partial render options in the INI file?)");
-    }
-    take_beauty(beauty, scratch.file("beauty.exr"), in);
+    beauty_render = povray.start("beauty", "beauty", "beauty.pov", width, height, {});
   }
-
-  // 3. The depth pass.
-  report.begin("depth pass (%dx%d, %s)... ", width, height, describe(distances).c_str());
-  std::vector<std::string> extra = data_pass;
-  for (const std::string& d : fog_declares(distances)) extra.push_back(d);
-  const double depth_seconds =
-      povray.render("depth pass", "depth", "depth.pov", width, height, extra);
-  if (beauty_seconds > 0.0) {
-    report.end("%.2f s (%.2f x the beauty)", depth_seconds, depth_seconds / beauty_seconds);
-  } else {
-    report.end("%.2f s", depth_seconds);
+  if (ambient_pass) {
+    // +Q3 skips shadows, reflection and refraction; +Q6 where +Q3 would show quick colours.
+    ambient_render = povray.start("ambient pass", "ambient", "ambient.pov", width, height,
+                                  {scan.uses_quick_color ? "+Q6" : "+Q3", "-A", "-UA"});
   }
-  {
-    const ssao_io::Image image = ssao_io::read_image(scratch.file("depth.exr"));
-    if (image.width != width || image.height != height) {
-      throw ssao_io::Error("POV-Ray rendered the depth pass at " + std::to_string(image.width) +
-                           "x" + std::to_string(image.height) + " instead of " +
-                           std::to_string(width) + "x" + std::to_string(height));
-    }
-    std::vector<float> precision;
-    const std::vector<float> depth =
-        decode_fog(image, distances, scratch.file("depth.exr"), &precision);
-    const DepthStats stats = depth_stats(depth);
-    if (stats.geometry == 0) {
-      report.warning("the depth pass saw no geometry: AO is 1 everywhere");
-    } else {
-      std::vector<float> errors;
-      for (size_t p = 0; p < depth.size(); ++p) {
-        if (std::isfinite(depth[p])) errors.push_back(precision[p]);
-      }
-      const DepthStats e = depth_stats(errors);
-      report.progress(
-          "  depth %.4g .. %.4g (median %.4g) on %.1f%% of the pixels; estimated "
-          "error (half-float rounding%s): median %.1e, 99%% %.1e, max %.1e of the depth",
-          stats.min, stats.max, stats.median,
-          100.0 * static_cast<double>(stats.geometry) / static_cast<double>(stats.total),
-          distances.d3 > 0.0 ? "" : " + leaked colour", e.median, e.p99, e.max);
-    }
-    // Fog depth is radial for a perspective camera and planar for an orthographic one.
-    in.planar_input = reading.camera.orthographic;
-    fill_planar_and_radial(in, depth, reading.camera.orthographic);
-  }
-
-  if (o.depth_only) {
-    const size_t count = static_cast<size_t>(width) * static_cast<size_t>(height);
-    std::vector<float> pixels(count * 2);
-    for (size_t p = 0; p < count; ++p) {
-      pixels[p * 2] = in.planar[p];
-      pixels[p * 2 + 1] = in.radial[p];
-    }
-    ssao_io::write_exr(o.output, width, height, {"Z", "Radial"}, pixels);
-    report.progress("wrote %s (Z, Radial) in %.2f s: pre-pass %.2f s, depth %.2f s",
-                    o.output.c_str(), seconds_since(start), prepass_seconds, depth_seconds);
-    return;
-  }
-
-  // 4. The exact normals of scenes that opt in.
-  double normal_seconds = 0.0;
-  if (scan.includes_ssao_passes && !o.no_normals) {
-    report.begin("normal pass (ssao_passes.inc, %dx%d)... ", width, height);
+  if (!o.depth_only && scan.includes_ssao_passes && !o.no_normals) {
     // The basis of the camera every pass is rendered with, imposed on ssao_passes.inc (its
     // SSAOCamera/SSAOCameraBasis vectors could describe another camera, e.g. with --camera-*).
     std::vector<std::string> normal_pass = {"+Q6", "-A", "-UA", "Declare=SSAOPass=1"};
@@ -667,13 +636,198 @@ void run_render(const Options& o) {
         normal_pass.push_back(buffer);
       }
     }
-    normal_seconds =
-        povray.render("normal pass", "normals", "normals.pov", width, height, normal_pass);
-    report.end("%.2f s", normal_seconds);
-    const ssao_io::Image image = ssao_io::read_image(scratch.file("normals.exr"));
+    normal_render =
+        povray.start("normal pass", "normals", "normals.pov", width, height, normal_pass);
+  }
+
+  // The fog distances: given, from the camera's look_at distance, else from a small pre-pass.
+  FogDistances distances;
+  double prepass_seconds = 0.0;
+  bool guessed = false;
+  if (o.fog_distances) {
+    distances = *o.fog_distances;
+  } else if (reading.camera.look_at_distance > 0.0 && !reading.camera.orthographic) {
+    distances = camera_distances(reading.camera.look_at_distance);
+    guessed = true;
+  } else {
+    const int pw = std::min(width, std::clamp(width / 8, 16, 80));
+    const int ph =
+        std::max(1, static_cast<int>(std::lround(static_cast<double>(pw) * height / width)));
+    report.begin("depth-range pre-pass (%dx%d)... ", pw, ph);
+    std::vector<std::string> extra = data_pass;
+    for (const std::string& d : fog_declares(prepass_distances())) extra.push_back(d);
+    if (scan.uses_radiosity) extra.push_back("Declare=SSAODepthCheapRadiosity=1");
+    prepass_seconds = povray.render("depth-range pre-pass", "prepass", "depth.pov", pw, ph, extra);
+    const ssao_io::Image image = ssao_io::read_image(scratch.file("prepass.exr"));
+    const DepthStats stats =
+        depth_stats(decode_fog(image, prepass_distances(), scratch.file("prepass.exr")));
+    distances = choose_distances(stats);
+    if (stats.geometry == 0) {
+      report.end("%.2f s", prepass_seconds);
+      report.warning(
+          "the pre-pass saw no geometry (every ray missed); fog distances "
+          "D1 = 10, D2 = 100");
+    } else {
+      report.end("%.2f s: depths %.4g .. %.4g, median %.4g, 99%% below %.4g -> %s", prepass_seconds,
+                 stats.min, stats.max, stats.median, stats.p99, describe(distances).c_str());
+    }
+  }
+  auto start_depth = [&](const FogDistances& fogs) {
+    std::vector<std::string> extra = data_pass;
+    for (const std::string& d : fog_declares(fogs)) extra.push_back(d);
+    if (scan.uses_radiosity) extra.push_back("Declare=SSAODepthCheapRadiosity=1");
+    return povray.start("depth pass", "depth", "depth.pov", width, height, extra);
+  };
+  Render depth_render = start_depth(distances);
+  report.progress("rendering %s (%dx%d) at once...",
+                  o.depth_only   ? "the depth pass"
+                  : ambient_pass ? (normal_render.process ? "the beauty, depth, ambient and "
+                                                            "normal passes"
+                                                          : "the beauty, depth and ambient "
+                                                            "passes")
+                  : normal_render.process ? "the beauty, depth and normal passes"
+                                          : "the beauty and the depth pass",
+                  width, height);
+  // The image file module (OpenImageIO) loads while POV-Ray renders.
+  ssao_io::preload_image_io();
+
+  // The depth pass.
+  double depth_seconds = 0.0;
+  std::vector<float> depth;
+  for (int attempt = 0;; ++attempt) {
+    depth_seconds += povray.finish(depth_render);
+    const ssao_io::Image image = ssao_io::read_image(depth_render.output);
+    if (image.width != width || image.height != height) {
+      throw ssao_io::Error("POV-Ray rendered the depth pass at " + std::to_string(image.width) +
+                           "x" + std::to_string(image.height) + " instead of " +
+                           std::to_string(width) + "x" + std::to_string(height));
+    }
+    std::vector<float> precision;
+    depth = decode_fog(image, distances, depth_render.output, &precision);
+    const DepthStats stats = depth_stats(depth);
+    if (stats.geometry == 0) {
+      report.progress("  depth pass %.2f s (%s): no geometry, AO is 1 everywhere", depth_seconds,
+                      describe(distances).c_str());
+      report.warning("the depth pass saw no geometry: AO is 1 everywhere");
+      break;
+    }
+    std::vector<float> errors;
+    for (size_t p = 0; p < depth.size(); ++p) {
+      if (std::isfinite(depth[p])) errors.push_back(precision[p]);
+    }
+    const DepthStats e = depth_stats(errors);
+    report.progress(
+        "  depth pass %.2f s (%s): depth %.4g .. %.4g (median %.4g) on %.1f%% of the pixels; "
+        "estimated error (half-float rounding%s): median %.1e, 99%% %.1e, max %.1e of the depth",
+        depth_seconds, describe(distances).c_str(), stats.min, stats.max, stats.median,
+        100.0 * static_cast<double>(stats.geometry) / static_cast<double>(stats.total),
+        distances.d3 > 0.0 ? "" : " + leaked colour", e.median, e.p99, e.max);
+    // The look_at guess covers 0.02 L .. 300 L; a scene mostly outside gets a second pass.
+    if (!guessed || attempt > 0 || (e.p99 <= 2e-3 && stats.median >= 0.02 * distances.d1)) break;
+    distances = choose_distances(stats);
+    report.warning(
+        "the depths are far from the camera's look_at distance; rendering the depth "
+        "pass again with " +
+        describe(distances));
+    depth_render = start_depth(distances);
+  }
+  // Fog depth is radial for a perspective camera and planar for an orthographic one.
+  in.planar_input = reading.camera.orthographic;
+  fill_planar_and_radial(in, depth, reading.camera.orthographic);
+
+  if (o.depth_only) {
+    const size_t count = static_cast<size_t>(width) * static_cast<size_t>(height);
+    std::vector<float> pixels(count * 2);
+    for (size_t p = 0; p < count; ++p) {
+      pixels[p * 2] = in.planar[p];
+      pixels[p * 2 + 1] = in.radial[p];
+    }
+    ssao_io::write_exr(o.output, width, height, {"Z", "Radial"}, pixels);
+    if (prepass_seconds > 0.0) {
+      report.progress("wrote %s (Z, Radial) in %.2f s: pre-pass %.2f s, depth %.2f s",
+                      o.output.c_str(), seconds_since(start), prepass_seconds, depth_seconds);
+    } else {
+      report.progress("wrote %s (Z, Radial) in %.2f s: depth %.2f s", o.output.c_str(),
+                      seconds_since(start), depth_seconds);
+    }
+    return;
+  }
+
+  // The beauty.
+  const double beauty_seconds = povray.finish(beauty_render);
+  {
+    const ssao_io::Image beauty = ssao_io::read_image(beauty_render.output);
+    if (beauty.width != width || beauty.height != height) {
+      throw ssao_io::Error("POV-Ray rendered the beauty at " + std::to_string(beauty.width) + "x" +
+                           std::to_string(beauty.height) + " instead of " + std::to_string(width) +
+                           "x" + std::to_string(height) +
+                           " (partial render options in the INI file?)");
+    }
+    take_beauty(beauty, beauty_render.output, in);
+  }
+  report.progress("  beauty %.2f s (the depth pass took %.2f x its time)", beauty_seconds,
+                  depth_seconds / beauty_seconds);
+
+  // The ambient term.
+  double ambient_seconds = 0.0;
+  if (ambient_pass) {
+    ambient_seconds = povray.finish(ambient_render);
+    const ssao_io::Image image = ssao_io::read_image(ambient_render.output);
+    if (image.width != width || image.height != height) {
+      throw ssao_io::Error("POV-Ray rendered the ambient pass at " + std::to_string(image.width) +
+                           "x" + std::to_string(image.height) + " instead of " +
+                           std::to_string(width) + "x" + std::to_string(height));
+    }
+    const V3 light = scan.ambient_light.value_or(V3{1.0, 1.0, 1.0});
+    size_t overflowed = 0;
+    const std::vector<float> rgb = decode_ambient(image, light, ambient_render.output, overflowed);
+    in.working_gamma = scan.assumed_gamma.value_or(1.0);
+    if (!(in.working_gamma > 0.0)) in.working_gamma = 1.0;
+    // The ambient term's share of the light, in the working space.
+    const size_t count = static_cast<size_t>(width) * static_cast<size_t>(height);
+    double ambient_sum = 0.0, light_sum = 0.0;
+    in.ambient.assign(count * 4, 0.0f);
+    for (size_t p = 0; p < count; ++p) {
+      for (size_t c = 0; c < 3; ++c) in.ambient[p * 4 + c] = rgb[p * 3 + c];
+      if (!std::isfinite(in.radial[p])) continue;
+      for (size_t c = 0; c < 3; ++c) {
+        ambient_sum += rgb[p * 3 + c];
+        const double b = in.beauty[p * 4 + c];
+        light_sum += b > 0.0 ? std::pow(b, 1.0 / in.working_gamma) : 0.0;
+      }
+    }
+    const double share = light_sum > 0.0 ? ambient_sum / light_sum : 0.0;
+    report.progress(
+        "  ambient pass %.2f s: the ambient light (ambient_light %s%s) is %.1f%% of "
+        "the image's light",
+        ambient_seconds, format_vector(light).c_str(),
+        scan.ambient_light ? "" : ", POV-Ray's default", 100.0 * share);
+    if (overflowed > 0) {
+      report.warning(std::to_string(overflowed) +
+                     " pixels have an ambient term too bright for the ambient pass (finish "
+                     "ambient x pigment above 6.5); AO leaves them unchanged");
+    }
+    if (share < 0.01) {
+      if (o.apply_to == "ambient") {
+        report.warning("the scene has almost no ambient light: AO changes little");
+      } else {
+        report.progress(
+            "AO darkens the whole image: the scene has almost no ambient light "
+            "(--apply-to ambient to darken only that)");
+        in.ambient.clear();
+      }
+    }
+  }
+
+  // The exact normals of scenes that opt in.
+  double normal_seconds = 0.0;
+  if (normal_render.process) {
+    normal_seconds = povray.finish(normal_render);
+    report.progress("  normal pass %.2f s", normal_seconds);
+    const ssao_io::Image image = ssao_io::read_image(normal_render.output);
     double unit_fraction = 0.0;
     std::vector<float> normals =
-        decode_normals(image, in.radial, scratch.file("normals.exr"), unit_fraction);
+        decode_normals(image, in.radial, normal_render.output, unit_fraction);
     if (image.width != width || image.height != height || unit_fraction < 0.9) {
       char buffer[64];
       std::snprintf(buffer, sizeof buffer, "%.0f%%", 100.0 * unit_fraction);
@@ -685,14 +839,23 @@ void run_render(const Options& o) {
     }
   }
 
-  // 5. AO and the outputs.
+  // AO and the outputs.
   const double ao_seconds = compute_and_write(o, in, report);
   std::string written = o.output + (o.exr.empty() ? "" : " and " + o.exr);
-  report.progress(
-      "wrote %s in %.2f s: pre-pass %.2f s, beauty %.2f s, depth %.2f s, "
-      "normals %.2f s, AO %.2f s",
-      written.c_str(), seconds_since(start), prepass_seconds, beauty_seconds, depth_seconds,
-      normal_seconds, ao_seconds);
+  std::string passes;
+  char buffer[64];
+  const std::pair<const char*, double> timings[] = {{"pre-pass", prepass_seconds},
+                                                    {"beauty", beauty_seconds},
+                                                    {"depth", depth_seconds},
+                                                    {"ambient", ambient_seconds},
+                                                    {"normals", normal_seconds}};
+  for (const auto& [what, seconds] : timings) {
+    if (seconds <= 0.0) continue;  // not rendered
+    std::snprintf(buffer, sizeof buffer, "%s%s %.2f s", passes.empty() ? "" : ", ", what, seconds);
+    passes += buffer;
+  }
+  report.progress("wrote %s in %.2f s (passes at once: %s; AO %.2f s)", written.c_str(),
+                  seconds_since(start), passes.c_str(), ao_seconds);
 }
 
 void run_post_process(const Options& o) {

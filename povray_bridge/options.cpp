@@ -49,7 +49,7 @@ using FrontOption = ssao_io::FrontOption<Options, Group>;
 const std::vector<FrontOption>& front_options() {
   static const std::vector<FrontOption> options = {
       {kRender, "--output", "-o", "OUT.png",
-       "output (required): .png, .jpg or .tif: an 8-bit sRGB image of beauty x AO; .exr: the "
+       "output (required): .png, .jpg or .tif: an 8-bit sRGB image of the result; .exr: the "
        "channels of --exr (with --depth-only: Z and Radial)",
        [](Options& o, const std::string&, const std::string& v) { o.output = v; }},
       {kRender, "--width", nullptr, "W",
@@ -63,7 +63,7 @@ const std::vector<FrontOption>& front_options() {
        "antialiasing, Declare=...); its Width and Height set the size unless given here",
        [](Options& o, const std::string&, const std::string& v) { o.ini = v; }},
       {kRender, "--exr", nullptr, "OUT.exr",
-       "also write 32-bit float channels R,G,B,A (beauty x AO, linear; A = 1 without alpha), "
+       "also write 32-bit float channels R,G,B,A (the output, linear; A = 1 without alpha), "
        "AO, Z (planar depth along the view axis; background inf) and Radial (distance from the "
        "camera; background inf)",
        [](Options& o, const std::string&, const std::string& v) { o.exr = v; }},
@@ -71,15 +71,26 @@ const std::vector<FrontOption>& front_options() {
        "keep the generated wrappers, the povray logs and every pass in DIR (created if needed; "
        "kept on failure too)",
        [](Options& o, const std::string&, const std::string& v) { o.keep = v; }},
+      {kRender, "--apply-to", nullptr, "auto|ambient|beauty",
+       "what AO darkens. ambient: only the scene's ambient light (pigment x finish ambient x "
+       "ambient_light, rendered as its own pass), so light straight from a light source stays; "
+       "beauty: the whole image (multiplied by AO); auto (default): ambient where the scene has "
+       "ambient light (at least 1% of the image's light), else beauty",
+       [](Options& o, const std::string& f, const std::string& v) {
+         if (v != "auto" && v != "ambient" && v != "beauty") {
+           throw UsageError(f + " must be auto, ambient or beauty, got '" + v + "'");
+         }
+         o.apply_to = v;
+       }},
       {kRender, "--depth-only", nullptr, nullptr,
-       "render only the pre-pass and the depth pass and write -o OUT.exr with channels Z and "
-       "Radial",
+       "render only the depth pass (and the pre-pass, when the camera has no look_at) and "
+       "write -o OUT.exr with channels Z and Radial",
        [](Options& o, const std::string&, const std::string&) { o.depth_only = true; }},
       {kRender, "--povray", nullptr, "PATH", "POV-Ray 3.7 executable (default: povray in PATH)",
        [](Options& o, const std::string&, const std::string& v) { o.povray = v; }},
       {kRender, "--fog-distances", nullptr, "D1,D2[,D3]",
-       "skip the pre-pass and use these fog distances (scene units; D3 adds a third fog on B "
-       "for far depths)",
+       "use these fog distances for the depth pass (scene units; D3 adds a third fog on B for "
+       "far depths) instead of the camera's look_at distance or a pre-pass",
        [](Options& o, const std::string& f, const std::string& v) {
          const std::vector<std::string> parts = ssao_io::split(v, ',');
          if (parts.size() != 2 && parts.size() != 3) {
@@ -268,11 +279,11 @@ void validate(const Options& o) {
     check_output_name("-o", o.output, true);
     if (o.width || o.height || !o.ini.empty() || !o.keep.empty() || o.depth_only ||
         o.fog_distances || o.print_camera || o.no_normals || !o.povray_options.empty() ||
-        o.povray != "povray") {
+        o.povray != "povray" || o.apply_to != "auto") {
       throw UsageError(
           "post-process mode (--beauty, --depth) runs no povray: size, --ini, "
-          "--keep, --depth-only, --fog-distances, --print-camera, --povray and "
-          "POV-Ray options do not apply");
+          "--keep, --depth-only, --fog-distances, --print-camera, --povray, --apply-to and "
+          "POV-Ray options do not apply (it multiplies the beauty by AO)");
     }
     const CameraOverrides& c = o.camera;
     if (c.location || c.look_at || c.right || c.up || c.sky || c.direction) {
@@ -362,18 +373,21 @@ Options parse_args(int argc, const char* const* argv, const std::vector<ssao_par
 std::string usage_text(const std::vector<ssao_param_desc>& table) {
   std::string text =
       "Usage: povray-ssao SCENE.pov -o OUT.png [+W640 +H480] [--ini FILE.ini] [--exr OUT.exr]\n"
-      "                   [--keep DIR] [--depth-only] [--povray PATH] [--quiet]\n"
+      "                   [--apply-to auto|ambient|beauty] [--keep DIR] [--depth-only]\n"
+      "                   [--povray PATH] [--quiet]\n"
       "                   [--camera-* overrides] [AO parameters: --radius X, --samples N, ...]\n"
       "       povray-ssao --beauty IMAGE --depth DEPTH.exr [--depth-channel NAME]\n"
       "                   [--depth-kind radial|planar] (--camera-angle DEG [--camera-aspect R] |\n"
       "                   --camera-orthographic --camera-width W) -o OUT.png [--exr OUT.exr]\n"
       "\n"
       "Screen-space ambient occlusion for POV-Ray 3.7 scenes. POV-Ray has no depth output, so\n"
-      "povray-ssao renders the scene several times: a small pre-pass that measures the depth\n"
-      "range, the beauty (with your quality settings), a depth pass (the scene wrapped so that\n"
-      "two additive fogs encode the distance: +Q9 -A +FE) and, for scenes that include\n"
-      "ssao_passes.inc, an exact normal pass. It computes AO with libssao and writes\n"
-      "OUT.png = beauty x AO, multiplied in linear light; the background is left unchanged.\n"
+      "povray-ssao renders the scene several times, all at once: the beauty (with your quality\n"
+      "settings), a depth pass (the scene wrapped so that additive fogs encode the distance:\n"
+      "+Q9 -A +FE), an ambient pass (the scene's ambient term alone: +Q3 -A +FE) and, for\n"
+      "scenes that include ssao_passes.inc, an exact normal pass. It computes AO with libssao\n"
+      "and writes OUT.png = beauty - (1 - AO) x ambient (--apply-to ambient, the default where\n"
+      "the scene has ambient light) or beauty x AO (--apply-to beauty), in linear light; the\n"
+      "background is left unchanged.\n"
       "\n"
       "Render mode:\n";
   text += help_entry("SCENE.pov",
@@ -391,7 +405,8 @@ std::string usage_text(const std::vector<ssao_param_desc>& table) {
   text += help_entry("+SWITCH, NAME=VALUE",
                      "any other POV-Ray option (+A0.3, +R3, +K0.5, Declare=Detail=2, ...) goes "
                      "to every povray run before povray-ssao's own options, which override it in "
-                     "the data passes (+Q9 -A -UA +FE for depth, +Q6 -A -UA +FE for normals); +I, "
+                     "the data passes (+Q9 -A -UA +FE for depth, +Q3 -A -UA +FE for the ambient "
+                     "term, +Q6 -A -UA +FE for normals); +I, "
                      "+O and +F are povray-ssao's");
   text +=
       "\nCamera (read from the scene: the last camera { } block, or SSAOCamera(...) of\n"
@@ -432,23 +447,33 @@ std::string usage_text(const std::vector<ssao_param_desc>& table) {
       "            fitted horizontally; orthographic ortho_scale = |right|; pixel aspect from\n"
       "            |right| / |up| against W / H.\n"
       "  Depth     d = -D log1p(-R / 60000) from the fog on R, or from the fog on G once\n"
-      "            d >= 0.7 D1; rays that hit nothing (R = G = 60000) are background (AO 1,\n"
-      "            Z = inf). EXR output is half-float, so the error depends on x = d / D:\n"
-      "            about 4e-4 of d for x in 0.1..0.7. The pre-pass (1/8 of the size, at most\n"
-      "            80 pixels wide, fogs 1, 100 and 10000) measures the depths; then\n"
-      "            D1 = 1.5 x the median depth and D2 = the 99th percentile / 2, kept within\n"
-      "            10..40 x D1; if the farthest depth exceeds 2 x D2, a third fog on B with\n"
-      "            D3 = the farthest depth (at least 10 x D2) reads the far range beyond\n"
-      "            2 x D2. Depths beyond about 8 x the last fog's distance read as background.\n"
+      "            d >= 0.7 D1 (then B once d >= 2 D2); rays that hit nothing are background\n"
+      "            (AO 1, Z = inf). EXR output is half-float, so the error depends on\n"
+      "            x = d / D: about 4e-4 of d for x up to 0.7. A camera with look_at at\n"
+      "            distance L gets D1 = 1.5 L, D2 = 10 D1, D3 = 100 D1 (0.02 L .. 300 L within\n"
+      "            2e-3; rendered again with fogs from the measured depths when they fall\n"
+      "            outside). Without look_at, a pre-pass (1/8 of the size, at most 80 pixels\n"
+      "            wide, fogs 1, 100 and 10000) measures the depths; then D1 = 1.5 x the\n"
+      "            median depth and D2 = the 99th percentile / 2, kept within 10..40 x D1; if\n"
+      "            the farthest depth exceeds 2 x D2, a third fog on B with D3 = the farthest\n"
+      "            depth (at least 10 x D2). Depths beyond about 8 x the last fog's distance\n"
+      "            read as background.\n"
       "            The estimated error of the depth is printed. Glass and mirrors give the\n"
       "            depth of their own surface; no_image objects are not seen.\n"
-      "  Radius    without --radius: 5% of the median depth (perspective) or of the view\n"
-      "            width |right| (orthographic), in scene units; printed.\n"
+      "  Radius    without --radius: 10% of the view's width at the median depth\n"
+      "            (orthographic: of the view's width |right|), in scene units; printed.\n"
+      "  Ambient   the ambient pass sets ambient_light rgb 10000 after the scene; divided by\n"
+      "            10000 and multiplied by the scene's ambient_light (read from its\n"
+      "            global_settings, default rgb 1) it is the ambient term of the beauty. Not\n"
+      "            rendered for scenes with radiosity (POV-Ray 3.7 then ignores ambient) or an\n"
+      "            ambient_light povray-ssao cannot read; --apply-to auto multiplies when the\n"
+      "            ambient light is under 1% of the image's light.\n"
       "  Normals   reconstructed from the depth by libssao, except for scenes that include\n"
       "            \"ssao_passes.inc\": their exact normal pass (Declare=SSAOPass=1 +Q6, the\n"
       "            rendered camera's basis given as Declare=SSAOBasis...).\n"
       "  Includes  +L<the scene's folder> and +L<povray-ssao's includes: ssao_depth_pre.inc,\n"
-      "            ssao_depth_post.inc, ssao_passes.inc> (<bin>/../share/povray-ssao, else the\n"
+      "            ssao_depth_post.inc, ssao_ambient_post.inc, ssao_passes.inc>\n"
+      "            (<bin>/../share/povray-ssao, else the\n"
       "            source tree's povray_bridge/pov) on every povray run.\n"
       "\n"
       "Progress and timings go to stdout; warnings, errors and POV-Ray's error lines to stderr.\n"

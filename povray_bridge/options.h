@@ -32,6 +32,7 @@ struct Options {
   std::string povray = "povray";
   std::vector<std::string> povray_options;  // +X switches and Name=value options, in order
   std::optional<FogDistances> fog_distances;
+  std::string apply_to = "auto";  // auto | ambient | beauty
   CameraOverrides camera;
 
   // Post-process mode.

@@ -43,6 +43,8 @@ void write_wrappers(const std::string& folder, const std::string& scene_name,
   write_text(folder + "/beauty.pov", header + scene + cam);
   write_text(folder + "/depth.pov", header + "#include \"ssao_depth_pre.inc\"\n" + scene + cam +
                                         "#include \"ssao_depth_post.inc\"\n");
+  write_text(folder + "/ambient.pov", header + "#include \"ssao_depth_pre.inc\"\n" + scene + cam +
+                                          "#include \"ssao_ambient_post.inc\"\n");
   write_text(folder + "/normals.pov", header + "#include \"ssao_depth_pre.inc\"\n" + scene + cam);
 }
 
@@ -52,6 +54,14 @@ std::vector<std::string> fog_declares(const FogDistances& distances) {
                                   "Declare=SSAODepthD2=" + number(distances.d2)};
   if (distances.d3 > 0.0) out.push_back("Declare=SSAODepthD3=" + number(distances.d3));
   return out;
+}
+
+FogDistances camera_distances(double look_distance) {
+  FogDistances d;
+  d.d1 = 1.5 * look_distance;
+  d.d2 = 10.0 * d.d1;
+  d.d3 = 100.0 * d.d1;
+  return d;
 }
 
 FogDistances prepass_distances() {
@@ -147,6 +157,34 @@ FogDistances choose_distances(const DepthStats& stats) {
   // farthest depth, hence the generous third fog.
   if (stats.max > 2.0 * out.d2) out.d3 = std::max(10.0 * out.d2, stats.max);
   return out;
+}
+
+std::vector<float> decode_ambient(const ssao_io::Image& image, V3 ambient_light,
+                                  const std::string& path, size_t& overflowed) {
+  const int channel[3] = {ssao_io::require_channel(image, "R", path),
+                          ssao_io::require_channel(image, "G", path),
+                          ssao_io::require_channel(image, "B", path)};
+  const double light[3] = {ambient_light.x, ambient_light.y, ambient_light.z};
+  const size_t stride = static_cast<size_t>(image.channels());
+  std::vector<float> ambient(image.pixel_count() * 3, 0.0f);
+  overflowed = 0;
+  for (size_t p = 0; p < image.pixel_count(); ++p) {
+    float values[3];
+    bool valid = true;
+    for (int c = 0; c < 3; ++c) {
+      values[c] = image.pixels[p * stride + static_cast<size_t>(channel[c])];
+      valid = valid && std::isfinite(values[c]) && values[c] < 65000.0f;
+    }
+    if (!valid) {
+      ++overflowed;
+      continue;
+    }
+    for (int c = 0; c < 3; ++c) {
+      ambient[p * 3 + static_cast<size_t>(c)] =
+          static_cast<float>(std::max(0.0, values[c] / kAmbientScale * light[c]));
+    }
+  }
+  return ambient;
 }
 
 std::vector<float> decode_normals(const ssao_io::Image& image, const std::vector<float>& depth,

@@ -30,13 +30,20 @@ struct FogDistances {
   bool coarse = false;  // the pre-pass: each channel read up to x = 4
 };
 
-// The wrapper files, written into `folder`: beauty.pov, depth.pov and normals.pov.
+// The ambient pass (docs/povray.md): the scene under ambient_light S (ssao_ambient_post.inc).
+constexpr double kAmbientScale = 10000.0;
+
+// The wrapper files, written into `folder`: beauty.pov, depth.pov, ambient.pov and normals.pov.
 // `scene_name` is the scene's file name (POV-Ray runs in the scene's folder).
 void write_wrappers(const std::string& folder, const std::string& scene_name,
                     const ResolvedCamera& camera);
 
 // POV-Ray's Declare= options for the fog distances (and K).
 std::vector<std::string> fog_declares(const FogDistances& distances);
+
+// The fog distances for a camera that looks at a point L away: D1 = 1.5 L, D2 = 10 D1 and
+// D3 = 100 D1 read depths from about 0.02 L to 300 L within 2e-3 without a pre-pass.
+FogDistances camera_distances(double look_distance);
 
 // The fog distances of the pre-pass: three fogs 1, 100 and 10000 scene units apart, which
 // read depths from about 0.002 to 40000 scene units to better than 1%.
@@ -63,6 +70,12 @@ DepthStats depth_stats(const std::vector<float>& depth);
 // 10 x D1 and at most 40 x D1; if the farthest depth exceeds 2 x D2, a third fog on B with
 // D3 = the farthest depth, at least 10 x D2. Without geometry: D1 = 10, D2 = 100.
 FogDistances choose_distances(const DepthStats& stats);
+
+// The ambient term of each pixel (R, G, B; linear, the scene's working space) from the ambient
+// pass: value / kAmbientScale x `ambient_light`. Pixels that overflowed half-float (a finish
+// ambient x pigment above 6.5) or are not finite get 0 and are counted in `overflowed`.
+std::vector<float> decode_ambient(const ssao_io::Image& image, V3 ambient_light,
+                                  const std::string& path, size_t& overflowed);
 
 // Decodes the opt-in normal pass (ssao_passes.inc, SSAOPass=1): per channel
 // n = sin(pi (v - 1/2)) in POV-Ray's camera basis (x right, y up, z forward), returned in

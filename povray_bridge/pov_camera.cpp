@@ -458,6 +458,7 @@ ResolvedCamera resolve(const Spec& spec, const CameraOverrides& overrides,
 
   V3 location{0, 0, 0}, direction{0, 0, 1}, up{0, 1, 0}, right{1.33, 0, 0}, sky{0, 1, 0};
   V3 look_at{0, 0, 1};
+  bool has_look_at = false;
   if (spec.base && !overrides.any()) {
     ResolvedCamera base = *spec.base;
     location = base.location;
@@ -509,6 +510,7 @@ ResolvedCamera resolve(const Spec& spec, const CameraOverrides& overrides,
           normalized(direction) * (length(right) / std::tan(*given_angle * M_PI / 360.0) / 2.0);
     }
     if (given_look_at) {
+      has_look_at = true;
       look_at = *given_look_at;
       const double direction_length = length(direction);
       const double up_length = length(up);
@@ -547,6 +549,7 @@ ResolvedCamera resolve(const Spec& spec, const CameraOverrides& overrides,
   Affine all;
   for (const Affine& a : spec.transforms) all = all.then(a);
   camera.location = all.point(location);
+  if (has_look_at) camera.look_at_distance = length(all.point(look_at) - camera.location);
   camera.direction = all.direction(direction);
   camera.right = all.direction(right);
   camera.up = all.direction(up);

@@ -39,6 +39,9 @@ struct ResolvedCamera {
   V3 direction{0, 0, 1};
   V3 right{1.33, 0, 0};
   V3 up{0, 1, 0};
+  // |look_at - location| when the camera was given a look_at (0 otherwise): where the scene's
+  // subject is, which places the depth pass's fogs without a pre-pass.
+  double look_at_distance = 0.0;
 
   // Horizontal field of view in degrees (perspective).
   double horizontal_fov() const;

@@ -2,6 +2,8 @@
 #include "povray_run.h"
 
 #include <fcntl.h>
+#include <poll.h>
+#include <sys/inotify.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -71,8 +73,21 @@ std::string find_executable(const std::string& name) {
                        "--povray PATH)");
 }
 
-RenderResult run_process(const std::string& executable, const std::vector<std::string>& args,
-                         const std::string& working_directory, const std::string& log_path) {
+RunningProcess::RunningProcess(const std::string& executable, const std::vector<std::string>& args,
+                               const std::string& working_directory, const std::string& log_path,
+                               const std::string& output)
+    : executable_(executable), working_directory_(working_directory), log_path_(log_path) {
+  if (!output.empty()) {
+    // Watched before the process starts, so that no close can be missed.
+    inotify_ = ::inotify_init1(IN_CLOEXEC | IN_NONBLOCK);
+    const fs::path folder = fs::path(output).parent_path();
+    if (inotify_ >= 0 &&
+        ::inotify_add_watch(inotify_, folder.empty() ? "." : folder.c_str(), IN_CLOSE_WRITE) < 0) {
+      ::close(inotify_);
+      inotify_ = -1;
+    }
+    output_name_ = fs::path(output).filename().string();
+  }
   const int log = ::open(log_path.c_str(), O_WRONLY | O_CREAT | O_APPEND | O_CLOEXEC, 0644);
   if (log < 0) {
     throw ssao_io::Error("cannot create the log file '" + log_path + "': " + std::strerror(errno));
@@ -84,13 +99,13 @@ RenderResult run_process(const std::string& executable, const std::vector<std::s
   for (std::string& arg : argv_strings) argv.push_back(arg.data());
   argv.push_back(nullptr);
 
-  const auto start = std::chrono::steady_clock::now();
-  const pid_t child = ::fork();
-  if (child < 0) {
+  start_ = std::chrono::steady_clock::now();
+  child_ = ::fork();
+  if (child_ < 0) {
     ::close(log);
     throw ssao_io::Error(std::string("cannot start POV-Ray: fork failed: ") + std::strerror(errno));
   }
-  if (child == 0) {
+  if (child_ == 0) {
     // The child: only async-signal-safe calls until exec.
     const int null_in = ::open("/dev/null", O_RDONLY);
     if (null_in >= 0) ::dup2(null_in, 0);
@@ -107,22 +122,71 @@ RenderResult run_process(const std::string& executable, const std::vector<std::s
     ::_exit(127);
   }
   ::close(log);
+}
 
+RunningProcess::~RunningProcess() {
+  if (inotify_ >= 0) ::close(inotify_);
+  if (child_ <= 0) return;
+  // Not waited for: an error elsewhere ends the run, so this render is not needed; or its image
+  // is written and it is only shutting down.
+  ::kill(child_, output_written_ ? SIGKILL : SIGTERM);
+  int status = 0;
+  while (::waitpid(child_, &status, 0) < 0 && errno == EINTR) {
+  }
+}
+
+RenderResult RunningProcess::wait_for_output() {
+  if (inotify_ < 0) return wait();
+  if (child_ <= 0) throw ssao_io::Error("internal error: waited twice for a POV-Ray run");
+  alignas(inotify_event) char buffer[4096];
+  while (true) {
+    int status = 0;
+    const pid_t done = ::waitpid(child_, &status, WNOHANG);
+    if (done == child_) return reaped(status);
+    if (done < 0 && errno != EINTR) {
+      throw ssao_io::Error(std::string("waiting for POV-Ray failed: ") + std::strerror(errno));
+    }
+    if (g_interrupted) return wait();  // forwards the interruption and throws
+    pollfd events{inotify_, POLLIN, 0};
+    if (::poll(&events, 1, 20) <= 0) continue;  // 20 ms: also the exit check's period
+    const ssize_t length = ::read(inotify_, buffer, sizeof buffer);
+    for (ssize_t offset = 0; offset < length;) {
+      const auto* event = reinterpret_cast<const inotify_event*>(buffer + offset);
+      if (event->len > 0 && output_name_ == event->name) output_written_ = true;
+      offset += static_cast<ssize_t>(sizeof(inotify_event) + event->len);
+    }
+    if (output_written_) {
+      RenderResult result;
+      result.seconds =
+          std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+      result.output_written = true;
+      return result;
+    }
+  }
+}
+
+RenderResult RunningProcess::wait() {
+  if (child_ <= 0) throw ssao_io::Error("internal error: waited twice for a POV-Ray run");
   int status = 0;
   bool forwarded = false;
   while (true) {
-    const pid_t done = ::waitpid(child, &status, 0);
-    if (done == child) break;
+    const pid_t done = ::waitpid(child_, &status, 0);
+    if (done == child_) break;
     if (done < 0 && errno != EINTR) {
       throw ssao_io::Error(std::string("waiting for POV-Ray failed: ") + std::strerror(errno));
     }
     if (g_interrupted && !forwarded) {
-      ::kill(child, SIGTERM);
+      ::kill(child_, SIGTERM);
       forwarded = true;
     }
   }
+  return reaped(status);
+}
+
+RenderResult RunningProcess::reaped(int status) {
+  child_ = -1;
   RenderResult result;
-  result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
   if (WIFEXITED(status)) {
     result.exit_status = WEXITSTATUS(status);
   } else if (WIFSIGNALED(status)) {
@@ -130,16 +194,22 @@ RenderResult run_process(const std::string& executable, const std::vector<std::s
   }
   if (g_interrupted) throw ssao_io::Error("interrupted; nothing written");
   if (result.exit_status == 127 || result.exit_status == 126) {
-    std::ifstream file(log_path);
+    std::ifstream file(log_path_);
     std::string text((std::istreambuf_iterator<char>(file)), std::istreambuf_iterator<char>());
     if (text.find("povray-ssao: cannot execute POV-Ray") != std::string::npos) {
-      throw ssao_io::Error("cannot execute '" + executable + "'");
+      throw ssao_io::Error("cannot execute '" + executable_ + "'");
     }
     if (text.find("povray-ssao: cannot enter the scene's folder") != std::string::npos) {
-      throw ssao_io::Error("cannot enter the scene's folder '" + working_directory + "'");
+      throw ssao_io::Error("cannot enter the scene's folder '" + working_directory_ + "'");
     }
   }
   return result;
+}
+
+RenderResult run_process(const std::string& executable, const std::vector<std::string>& args,
+                         const std::string& working_directory, const std::string& log_path) {
+  RunningProcess process(executable, args, working_directory, log_path);
+  return process.wait();
 }
 
 std::string povray_error_lines(const std::string& log_path, size_t max_lines) {

@@ -3,6 +3,9 @@
 // lines of a failed render, the image size POV-Ray would use, a scratch folder, Ctrl-C.
 #pragma once
 
+#include <sys/types.h>
+
+#include <chrono>
 #include <string>
 #include <vector>
 
@@ -15,13 +18,44 @@ namespace povray_ssao {
 std::string find_executable(const std::string& name);
 
 struct RenderResult {
-  int exit_status = 0;   // POV-Ray's exit code (128 + signal if it was killed)
-  double seconds = 0.0;  // wall-clock time
+  int exit_status = 0;          // POV-Ray's exit code (128 + signal if it was killed)
+  double seconds = 0.0;         // wall-clock time
+  bool output_written = false;  // wait_for_output(): the output file was closed after writing
+                                // while the process was still shutting down
 };
 
-// Runs `executable args...` in `working_directory` with stdin from /dev/null and stdout and
-// stderr appended to `log_path`. Throws ssao_io::Error if it cannot be started, or when the user
-// interrupted it (SIGINT/SIGTERM, forwarded to POV-Ray).
+// `executable args...` running in `working_directory` with stdin from /dev/null and stdout and
+// stderr appended to `log_path`, started by the constructor (which throws ssao_io::Error if it
+// cannot start). wait() returns its result; it throws ssao_io::Error when the user interrupted
+// it (SIGINT/SIGTERM, forwarded to POV-Ray) or it could not be executed. A process that is not
+// waited for is terminated (SIGTERM) and reaped by the destructor, so a failure elsewhere
+// leaves no render behind.
+//
+// With `output` given, wait_for_output() also returns as soon as the process has closed that
+// file after writing it (inotify): POV-Ray 3.7 writes its image last and then spends about 0.3 s
+// shutting down (message polling), which need not be waited for. Such a process is killed
+// (SIGKILL) and reaped by the destructor unless it has exited by then.
+class RunningProcess {
+ public:
+  RunningProcess(const std::string& executable, const std::vector<std::string>& args,
+                 const std::string& working_directory, const std::string& log_path,
+                 const std::string& output = "");
+  ~RunningProcess();
+  RunningProcess(const RunningProcess&) = delete;
+  RunningProcess& operator=(const RunningProcess&) = delete;
+  RenderResult wait();
+  RenderResult wait_for_output();
+
+ private:
+  RenderResult reaped(int status);
+  std::string executable_, working_directory_, log_path_, output_name_;
+  pid_t child_ = -1;
+  int inotify_ = -1;
+  bool output_written_ = false;
+  std::chrono::steady_clock::time_point start_;
+};
+
+// Starts the process and waits for it.
 RenderResult run_process(const std::string& executable, const std::vector<std::string>& args,
                          const std::string& working_directory, const std::string& log_path);
 

@@ -602,6 +602,52 @@ SdlValue evaluate_full(const std::vector<Token>& tokens, size_t& pos, const Eval
   return parser.full_expression();
 }
 
+bool starts_colour_keyword(const Token& token) {
+  static const std::set<std::string> keywords = {"color", "colour", "rgb",   "rgbf",   "rgbt",
+                                                 "rgbft", "srgb",   "srgbf", "srgbt",  "srgbft",
+                                                 "red",   "green",  "blue",  "filter", "transmit"};
+  return token.kind == Token::kIdent && keywords.count(token.text) > 0;
+}
+
+SdlValue evaluate_colour(const std::vector<Token>& tokens, size_t& pos,
+                         const EvalContext& context) {
+  auto is_ident = [&](const char* text) {
+    return tokens[pos].kind == Token::kIdent && tokens[pos].text == text;
+  };
+  if (is_ident("color") || is_ident("colour")) ++pos;
+  const Token& first = tokens[pos];
+  if (first.kind == Token::kIdent &&
+      (first.text == "rgbf" || first.text == "rgbt" || first.text == "rgbft" ||
+       first.text == "srgbf" || first.text == "srgbt" || first.text == "srgbft" ||
+       first.text == "filter" || first.text == "transmit")) {
+    throw EvalError(where(first) + ": '" + first.text + "' colours are not read by povray-ssao");
+  }
+  if (is_ident("rgb") || is_ident("srgb")) {
+    const bool srgb = is_ident("srgb");
+    ++pos;
+    SdlValue value;
+    value.is_vector = true;
+    value.v = evaluate(tokens, pos, context).vector();
+    if (srgb) {
+      for (double* c : {&value.v.x, &value.v.y, &value.v.z}) {
+        *c = *c <= 0.04045 ? *c / 12.92 : std::pow((*c + 0.055) / 1.055, 2.4);
+      }
+    }
+    return value;
+  }
+  if (is_ident("red") || is_ident("green") || is_ident("blue")) {
+    SdlValue value;
+    value.is_vector = true;
+    while (is_ident("red") || is_ident("green") || is_ident("blue")) {
+      const std::string component = tokens[pos++].text;
+      const double number = evaluate(tokens, pos, context).number();
+      (component == "red" ? value.v.x : component == "green" ? value.v.y : value.v.z) = number;
+    }
+    return value;
+  }
+  return evaluate(tokens, pos, context);
+}
+
 bool starts_expression(const std::vector<Token>& tokens, size_t pos) {
   const Token& token = tokens[pos];
   if (token.kind == Token::kNumber) return true;
@@ -808,6 +854,13 @@ class Scanner {
         ++i;
         continue;
       }
+      if (token.kind == Token::kIdent) {
+        const size_t next = global_setting(tokens, i);
+        if (next != i) {
+          i = next;
+          continue;
+        }
+      }
       const bool block =
           token.kind == Token::kIdent && token.text == "camera" && is_punct(tokens[i + 1], "{");
       const bool macro =
@@ -828,6 +881,52 @@ class Scanner {
       }
       ++i;
     }
+  }
+
+  // The global_settings items povray-ssao's passes depend on, and quick colours. Returns the
+  // index after what it read, or i for any other token.
+  size_t global_setting(const std::vector<Token>& tokens, size_t i) {
+    const std::string& name = tokens[i].text;
+    if (name == "quick_color" || name == "quick_colour") {
+      result.uses_quick_color = true;
+      return i;
+    }
+    if (name == "global_settings" && is_punct(tokens[i + 1], "{")) {
+      settings_end_ = skip_group(tokens, i + 1);
+      return i + 2;
+    }
+    if (i >= settings_end_) return i;
+    if (name == "radiosity" && is_punct(tokens[i + 1], "{")) {
+      result.uses_radiosity = true;
+      return skip_group(tokens, i + 1);
+    }
+    if (name == "assumed_gamma") {
+      size_t pos = i + 1;
+      try {
+        const double gamma = evaluate(tokens, pos, context_).number();
+        if (!result.assumed_gamma) result.assumed_gamma = gamma;
+      } catch (const EvalError& e) {
+        if (!result.assumed_gamma) {
+          result.notes.push_back(std::string("cannot read the scene's assumed_gamma (") + e.what() +
+                                 ")");
+        }
+        return i + 1;
+      }
+      return pos;
+    }
+    if (name == "ambient_light") {
+      size_t pos = i + 1;
+      try {
+        result.ambient_light = evaluate_colour(tokens, pos, context_).vector();
+        result.ambient_light_problem.clear();
+      } catch (const EvalError& e) {
+        result.ambient_light.reset();
+        result.ambient_light_problem = where(tokens[i]) + ": " + e.what();
+        return i + 1;
+      }
+      return pos;
+    }
+    return i;
   }
 
   // Handles the (non-conditional) directive at tokens[i] in an active region; returns the
@@ -886,6 +985,8 @@ class Scanner {
     }
     // An include starts and ends outside any conditional of its own.
     Conditionals saved = conditionals_;
+    const size_t saved_settings_end = settings_end_;
+    settings_end_ = 0;
     try {
       scan_file(path.string(), name, depth + 1);
     } catch (const ssao_io::Error& e) {
@@ -893,6 +994,7 @@ class Scanner {
                              e.what() + ")");
     }
     conditionals_ = saved;
+    settings_end_ = saved_settings_end;
   }
 
   // After "#declare" / "#local": NAME = VALUE [;]
@@ -948,10 +1050,11 @@ class Scanner {
         return i + 2;
       }
     }
-    // A number or a vector, ended by ';'.
+    // A number, a vector or a colour, ended by ';'.
     size_t pos = i;
     try {
-      symbol.value = evaluate_full(tokens, pos, context_);
+      symbol.value = starts_colour_keyword(first) ? evaluate_colour(tokens, pos, context_)
+                                                  : evaluate_full(tokens, pos, context_);
       if (is_punct(tokens[pos], ";") || tokens[pos].kind == Token::kDirective ||
           tokens[pos].kind == Token::kEnd) {
         symbol.kind = Symbol::kValue;
@@ -982,6 +1085,7 @@ class Scanner {
   }
 
   const ScanSettings& settings_;
+  size_t settings_end_ = 0;  // index after the global_settings block being read (this file)
   Symbols symbols_;
   EvalContext context_;
   Conditionals conditionals_;

@@ -101,6 +101,16 @@ SdlValue evaluate(const std::vector<Token>& tokens, size_t& pos, const EvalConte
 // #declare and parentheses.
 SdlValue evaluate_full(const std::vector<Token>& tokens, size_t& pos, const EvalContext& context);
 
+// A colour expression as global_settings' ambient_light takes it: [color|colour] followed by
+// "rgb EXPR", "srgb EXPR" (decoded to linear), "red A green B blue C" (any of them, any order),
+// or a number, vector or identifier declared as one of these. Colours with filter or
+// transmit (rgbf, rgbt, 4- and 5-vectors) are not read: EvalError.
+SdlValue evaluate_colour(const std::vector<Token>& tokens, size_t& pos, const EvalContext& context);
+
+// True if tokens[pos] starts a colour expression with a keyword (color, colour, rgb, srgb, red,
+// green, blue, rgbf, ...).
+bool starts_colour_keyword(const Token& token);
+
 // True if tokens[pos] can start an expression (a number, '<', '(', '-', '+' or an identifier
 // that is not one of the camera's keywords).
 bool starts_expression(const std::vector<Token>& tokens, size_t pos);
@@ -153,6 +163,12 @@ struct SceneScan {
   double clock = 0.0;                         // the settings' clock, for evaluating the camera
   std::vector<std::string> notes;             // things worth a warning (unreadable includes, ...)
   std::vector<std::string> missing_includes;  // #include files not found (not read)
+  // global_settings, as far as the text tells (povray-ssao's ambient pass needs them):
+  std::optional<double> assumed_gamma;  // the first assumed_gamma (POV-Ray keeps the first)
+  std::optional<V3> ambient_light;      // the last readable ambient_light (default rgb 1)
+  std::string ambient_light_problem;    // why the last ambient_light could not be read, or ""
+  bool uses_radiosity = false;          // a radiosity { } block in global_settings
+  bool uses_quick_color = false;        // quick_color/quick_colour appears (used below +Q6)
 };
 
 struct ScanSettings {

@@ -28,6 +28,36 @@ PARAMS_HEADER = """
 |---|---|---|---|---|---|
 """
 
+FOOTER = """
+## The automatic radius
+
+`radius` defaults to 1 scene unit in the library, which suits no scene in particular. The
+front ends choose one when the user gives none: the CLI takes the camera file's `ao_distance`,
+else, like `povray-ssao`, the library's rule `ssao_job_auto_radius()`: **10% of the view's
+width (along the image's larger side) at the median depth of the geometry pixels**;
+orthographic: 10% of the view's width. Both print the radius and the flag that changes it.
+
+The 10% is the geometric mean over scenes whose AO distance an artist chose: the six benchmark
+scenes and the three development scenes (`/usr/bin/python3 benchmarks/radius_calibration.py`
+prints the benchmark's from `build/benchmark_kit`; the development scenes are not shipped):
+
+| scene | AO distance | median depth | view width there | ratio |
+|---|--:|--:|--:|--:|
+| cavity | 0.50 | 4.86 | 5.00 | 0.100 |
+| contact | 0.80 | 5.96 | 6.13 | 0.130 |
+| depth_range | 1.00 | 7.48 | 7.69 | 0.130 |
+| heavy | 0.80 | 5.50 | 5.66 | 0.141 |
+| ortho | 0.60 | 9.03 | 7.50 | 0.080 |
+| thin | 0.50 | 5.33 | 5.48 | 0.091 |
+| crates (development) | 0.80 | 8.67 | 8.92 | 0.090 |
+| shelf (development) | 0.50 | 6.76 | 8.11 | 0.062 |
+| arches (development) | 1.00 | 8.72 | 9.81 | 0.102 |
+
+Geometric mean 0.100 (median 0.100, range 0.062 to 0.141). The rule follows the framing, not
+the resolution: the same shot at another size gets the same radius. What it gives on POV-Ray's
+example scenes is in [povray.md](povray.md#the-default-radius).
+"""
+
 TYPES = {ssao_native.PARAM_INT: "int", ssao_native.PARAM_FLOAT: "float",
          ssao_native.PARAM_STRING: "choice", ssao_native.PARAM_FLOATS: "floats"}
 
@@ -63,7 +93,7 @@ def render(lib):
             span = f"{number(p['min'])} .. {number(p['max'])}"
         rows.append(f"| `{p['name']}` | {TYPES[p['type']]} | {default} | {span} | {p['unit']} "
                     f"| {p['description']} |")
-    return HEADER + render_variants(lib) + PARAMS_HEADER + "\n".join(rows) + "\n"
+    return HEADER + render_variants(lib) + PARAMS_HEADER + "\n".join(rows) + "\n" + FOOTER
 
 
 def main():

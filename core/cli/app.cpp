@@ -202,6 +202,29 @@ void print_summary(const Options& options, const ssao_io::Job& job, const Inputs
                milliseconds, mean, count);
 }
 
+// Without --radius: the camera file's ao_distance, else the core's automatic rule; said on
+// stderr with how to change it.
+void choose_radius(const Options& options, const ssao_io::Camera& camera, ssao_io::Job& job) {
+  for (const ssao_io::ParamSetting& setting : options.params) {
+    if (setting.name == "radius") return;
+  }
+  std::string why;
+  if (camera.ao_distance > 0.0) {
+    job.set("radius", camera.ao_distance);
+    why = "ao_distance of " + options.camera;
+  } else {
+    double radius = 0.0;
+    const ssao_status status = ssao_job_auto_radius(job.get(), &radius);
+    if (status != SSAO_OK) return;  // no geometry: AO is 1 whatever the radius
+    job.set("radius", radius);
+    why = "10% of the view's width at the median depth";
+  }
+  if (!options.quiet) {
+    std::fprintf(stderr, "ssao: radius %.4g scene units (%s; --radius to change)\n",
+                 job.get_float("radius"), why.c_str());
+  }
+}
+
 }  // namespace
 
 void run_ssao(const Options& options) {
@@ -216,6 +239,7 @@ void run_ssao(const Options& options) {
   Inputs in = load_inputs(options);
   Outputs out;
   attach_images(job, in, out);
+  choose_radius(options, camera, job);
   const double milliseconds = compute_ao(job, options.quiet);
   write_output(options, in, out);
   if (!options.quiet) print_summary(options, job, in, out, milliseconds);

@@ -123,6 +123,8 @@ std::string usage_text(const std::vector<ssao_param_desc>& table) {
       "(<layer>.Depth.Z, <layer>.Normal.X/Y/Z, <layer>.Combined.R/G/B/A; other files with\n"
       "plain channel names work too) and writes OUT.exr with R,G,B[,A] = beauty x AO (alpha\n"
       "copied) and an AO channel (1 = unoccluded), or only AO with --ao-only.\n"
+      "Without --radius, the radius is the camera file's \"ao_distance\", else 10% of the\n"
+      "view's width at the median depth (printed).\n"
       "\n"
       "Input and output:\n";
   text += help_entry("IN.exr", "input image (any file OpenImageIO reads)");

@@ -94,9 +94,9 @@ class Reader {
 
 const std::vector<std::string>& known_keys() {
   static const std::vector<std::string> keys = {
-      "type",         "lens",           "sensor_width",  "sensor_height", "sensor_fit",
-      "shift_x",      "shift_y",        "ortho_scale",   "clip_start",    "clip_end",
-      "matrix_world", "pixel_aspect_x", "pixel_aspect_y"};
+      "type",         "lens",           "sensor_width",   "sensor_height", "sensor_fit",
+      "shift_x",      "shift_y",        "ortho_scale",    "clip_start",    "clip_end",
+      "matrix_world", "pixel_aspect_x", "pixel_aspect_y", "ao_distance"};
   return keys;
 }
 
@@ -131,6 +131,11 @@ Camera parse_camera_json(const std::string& text, const std::string& source) {
   read.number("pixel_aspect_x", camera.pixel_aspect_x);
   read.number("pixel_aspect_y", camera.pixel_aspect_y);
   read.matrix("matrix_world", camera.matrix_world);
+  read.number("ao_distance", camera.ao_distance);
+  if (root.contains("ao_distance") && !(camera.ao_distance > 0.0)) {
+    throw Error("camera file '" + source + "': key 'ao_distance' must be positive, got " +
+                std::to_string(camera.ao_distance));
+  }
 
   for (const auto& item : root.items()) {
     bool known = false;

@@ -6,7 +6,9 @@
 // Keys are named after Blender's bpy.types.Camera properties. "type" is required; every other
 // key is optional and defaults to Blender's default for a new camera (below); matrix_world
 // (camera-to-world, row-major, camera looking down its local -Z with +Y up) defaults to the
-// identity. Optional "pixel_aspect_x"/"pixel_aspect_y" (render settings) default to 1. Keys
+// identity. Optional "pixel_aspect_x"/"pixel_aspect_y" (render settings) default to 1; optional
+// "ao_distance" (> 0, scene units; Blender's World > Ambient Occlusion > Distance) is the AO
+// radius the shot was made for, which the CLI uses when --radius is not given. Keys
 // the format does not know are reported in Camera::unknown_keys and otherwise ignored.
 #pragma once
 
@@ -32,6 +34,7 @@ struct Camera {
   double clip_end = 1000.0;
   double pixel_aspect_x = 1.0;
   double pixel_aspect_y = 1.0;
+  double ao_distance = 0.0;  // the AO radius chosen for this shot (scene units); 0: none given
   std::array<double, 16> matrix_world = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
   std::vector<std::string> unknown_keys;  // present in the file, not part of the format
 };

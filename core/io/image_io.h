@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: MIT
 // Float image files through OpenImageIO: read any OIIO-readable file (EXR first of all) into
-// interleaved float pixels, write OpenEXR atomically. OpenImageIO stays out of this header.
+// interleaved float pixels, write OpenEXR atomically. OpenImageIO stays out of this header and
+// out of the programs: it lives in the module libssao_image_codec.so, loaded on the first read
+// or write (or preload_image_io()).
 #pragma once
 
 #include <cstddef>
@@ -64,6 +66,11 @@ void write_preview(const std::string& path, int width, int height,
 
 // True for the extensions write_preview handles (.png, .jpg, .jpeg, .tif, .tiff).
 bool is_preview_path(const std::string& path);
+
+// Loads the image file module now (otherwise the first read or write does): a program that has
+// other work in flight calls it to overlap the loading (about 0.2 s) with that work. Throws Error
+// if the module cannot be loaded.
+void preload_image_io();
 
 // Comma-separated list of the names, for messages: "R, G, B".
 std::string join_names(const std::vector<std::string>& names, const char* separator = ", ");

@@ -93,6 +93,12 @@ class Job {
 
   // "hemisphere, quality medium" plus any count set explicitly (", 16 samples"): what the
   // front ends print about a run (a count left at 0 comes from the quality preset).
+  // The core's automatic radius for the attached depth and the camera (ssao_job_auto_radius).
+  double auto_radius() const {
+    double radius = 0.0;
+    check_status(ssao_job_auto_radius(job_, &radius), "automatic radius");
+    return radius;
+  }
   std::string settings_summary() const {
     std::string out = get_string("variant") + ", quality " + get_string("quality");
     for (const char* count : {"samples", "slices", "steps"}) {

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: MIT
 #include "job.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <limits>
@@ -20,8 +21,8 @@ struct ImageRule {
   const char* name;
   int min_channels, max_channels;
 };
-constexpr ImageRule kImageRules[] = {
-    {"depth", 1, 4}, {"normal", 3, 4}, {"beauty", 1, 4}, {"ao", 1, 4}, {"composite", 1, 4}};
+constexpr ImageRule kImageRules[] = {{"depth", 1, 4},   {"normal", 3, 4}, {"beauty", 1, 4},
+                                     {"ambient", 1, 4}, {"ao", 1, 4},     {"composite", 1, 4}};
 
 CameraParams camera_params(const ParamValues& v) {
   CameraParams c;
@@ -71,7 +72,47 @@ struct Shaping {
 // (at 1.6x the speed); at 640x360, 0.002 (pixels there are large next to contact shadows).
 constexpr double kHalfResolutionPixels = 1e6;
 
+// The automatic radius is this fraction of the view's extent (along the image's larger side) at
+// the median depth. Calibrated on the artist-chosen AO distances of the nine benchmark and
+// development scenes (docs/parameters.md): their ratio is 0.06 to 0.14, geometric mean 0.100.
+constexpr double kAutoRadiusFraction = 0.1;
+
+// Depth samples read for the median: every pixel up to this many, else a regular subset.
+constexpr size_t kAutoRadiusSamples = 1u << 20;
+
 }  // namespace
+
+double Job::auto_radius() const {
+  if (!depth_.attached()) throw_invalid_operation("no depth image: attach one with set_image");
+  const int width = depth_.width, height = depth_.height;
+  const ParamValues& v = params_;
+  const CameraModel camera(camera_params(v), std::max(width, 1), std::max(height, 1));
+  const bool radial = v.get_string("depth_kind") == "radial";
+  double limit = v.get_float("background_depth");
+  if (v.get_float("clip_end") > 0.0) limit = std::min(limit, v.get_float("clip_end"));
+  const size_t pixels = size_t(width) * size_t(height);
+  const size_t step = std::max<size_t>(1, pixels / kAutoRadiusSamples);
+  std::vector<float> planar;
+  planar.reserve(std::min(pixels, kAutoRadiusSamples + 1));
+  for (size_t i = 0; i < pixels; i += step) {
+    const int x = int(i % size_t(width)), y = int(i / size_t(width));
+    const float d = depth_.pixel(x, y)[0];
+    if (!(std::isfinite(d) && d > 0.0f && double(d) < limit)) continue;
+    // Radial depth over the length of the pixel's ray at planar depth 1.
+    planar.push_back(
+        radial ? d / length(camera.view_position(float(x) + 0.5f, float(y) + 0.5f, 1.0f)) : d);
+  }
+  if (planar.empty()) {
+    throw_invalid_operation(
+        "the depth image has no geometry pixel: no depth to size the radius by");
+  }
+  auto middle = planar.begin() + std::ptrdiff_t(planar.size() / 2);
+  std::nth_element(planar.begin(), middle, planar.end());
+  const double median = *middle;
+  const CameraIntrinsics k = camera.intrinsics();
+  const double extent = std::max(double(k.scale_u) * width, double(k.scale_v) * height);
+  return kAutoRadiusFraction * extent * (camera.orthographic() ? 1.0 : median);
+}
 
 void Job::set_image(const char* name, float* data, int width, int height, int channels,
                     std::ptrdiff_t pixel_stride, std::ptrdiff_t row_stride) {
@@ -82,13 +123,14 @@ void Job::set_image(const char* name, float* data, int width, int height, int ch
   }
   if (rule == nullptr) {
     throw_invalid_argument(std::string("unknown image '") + name +
-                           "' (expected depth, normal, beauty, ao or composite)");
+                           "' (expected depth, normal, beauty, ambient, ao or composite)");
   }
-  ImageView* slot = std::strcmp(name, "depth") == 0    ? &depth_
-                    : std::strcmp(name, "normal") == 0 ? &normal_
-                    : std::strcmp(name, "beauty") == 0 ? &beauty_
-                    : std::strcmp(name, "ao") == 0     ? &ao_out_
-                                                       : &composite_out_;
+  ImageView* slot = std::strcmp(name, "depth") == 0     ? &depth_
+                    : std::strcmp(name, "normal") == 0  ? &normal_
+                    : std::strcmp(name, "beauty") == 0  ? &beauty_
+                    : std::strcmp(name, "ambient") == 0 ? &ambient_
+                    : std::strcmp(name, "ao") == 0      ? &ao_out_
+                                                        : &composite_out_;
   if (data == nullptr) {
     *slot = ImageView{};
     return;
@@ -128,8 +170,11 @@ void Job::validate_images() const {
   if (!ao_out_.attached() && !composite_out_.attached()) {
     throw_invalid_operation("no output image: attach 'ao' or 'composite'");
   }
-  const std::pair<const char*, const ImageView*> others[] = {
-      {"normal", &normal_}, {"beauty", &beauty_}, {"ao", &ao_out_}, {"composite", &composite_out_}};
+  const std::pair<const char*, const ImageView*> others[] = {{"normal", &normal_},
+                                                             {"beauty", &beauty_},
+                                                             {"ambient", &ambient_},
+                                                             {"ao", &ao_out_},
+                                                             {"composite", &composite_out_}};
   for (const auto& [name, view] : others) {
     if (view->attached() && (view->width != depth_.width || view->height != depth_.height)) {
       throw_invalid_argument(std::string("image '") + name + "' is " + std::to_string(view->width) +
@@ -141,6 +186,10 @@ void Job::validate_images() const {
     if (!beauty_.attached()) throw_invalid_operation("'composite' output needs a 'beauty' image");
     if (composite_out_.channels != beauty_.channels) {
       throw_invalid_argument("'composite' has " + std::to_string(composite_out_.channels) +
+                             " channels but 'beauty' has " + std::to_string(beauty_.channels));
+    }
+    if (ambient_.attached() && ambient_.channels != beauty_.channels) {
+      throw_invalid_argument("'ambient' has " + std::to_string(ambient_.channels) +
                              " channels but 'beauty' has " + std::to_string(beauty_.channels));
     }
   }
@@ -239,7 +288,16 @@ void Job::run() {
         if (composite_out_.attached()) {
           const float* src = beauty_.pixel(x, y);
           float* dst = composite_out_.pixel(x, y);
-          for (int c = 0; c < composite_out_.channels; ++c) dst[c] = c < 3 ? src[c] * ao : src[c];
+          if (ambient_.attached()) {
+            // Only the ambient part darkens; never below 0 where the beauty is not.
+            const float* ambient = ambient_.pixel(x, y);
+            for (int c = 0; c < composite_out_.channels; ++c) {
+              const float darker = src[c] - (1.0f - ao) * ambient[c];
+              dst[c] = c >= 3 ? src[c] : (darker < 0.0f && src[c] >= 0.0f ? 0.0f : darker);
+            }
+          } else {
+            for (int c = 0; c < composite_out_.channels; ++c) dst[c] = c < 3 ? src[c] * ao : src[c];
+          }
         }
       }
     }

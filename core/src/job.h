@@ -26,6 +26,8 @@ class Job {
     progress_user_ = user;
   }
   void run();
+  // The automatic radius rule (docs/parameters.md) for the attached depth image and camera.
+  double auto_radius() const;
 
  private:
   void validate_images() const;
@@ -39,7 +41,7 @@ class Job {
   std::unique_ptr<TilePool> pool_;
   Frame frame_, half_frame_;
   std::vector<float> visibility_;
-  ImageView depth_, normal_, beauty_, ao_out_, composite_out_;
+  ImageView depth_, normal_, beauty_, ambient_, ao_out_, composite_out_;
   Progress::Callback progress_callback_ = nullptr;
   void* progress_user_ = nullptr;
 };

@@ -221,6 +221,43 @@ class GoodRunTest(CliTestCase):
         self.assertIn("64x48", proc.stderr)
         self.assertIn("mean AO", proc.stderr)
 
+    def test_radius_from_the_camera_file_or_the_automatic_rule(self):
+        def run(*args, camera=None):
+            if camera is not None:
+                self.camera = self.write_camera(camera)
+            if os.path.exists(self.output):
+                os.remove(self.output)
+            proc = self.run_ssao(self.input, "-o", self.output, "--camera", self.camera, *args,
+                                 default_paths=False)
+            self.assert_ok(proc)
+            names, out = read_image(self.output)
+            return proc.stderr, out[:, :, names.index("AO")]
+
+        # No --radius, no ao_distance: 10% of the view's width (36/35 x depth) at the median
+        # depth (the wall's, 10; the sky is beyond clip_end).
+        expected = 0.1 * WALL_DEPTH * 36.0 / 35.0
+        text, automatic = run()
+        self.assertIn("ssao: radius %.4g scene units (10%% of the view's width at the median "
+                      "depth; --radius to change)" % expected, text)
+        _, given = run("--radius", repr(expected))
+        np.testing.assert_allclose(automatic, given, rtol=0, atol=2e-6)
+        # The camera file's ao_distance, unless --radius is given.
+        text, from_file = run(camera=dict(CAMERA, ao_distance=2.5))
+        self.assertIn("ssao: radius 2.5 scene units (ao_distance of", text)
+        _, given = run("--radius", "2.5")
+        np.testing.assert_array_equal(from_file, given)
+        # 2.5 reaches from the box (depth 8) to the wall (10); the automatic 1.03 does not.
+        self.assertLess(float(from_file.min()), 0.95)
+        self.assertEqual(float(automatic.min()), 1.0)
+        text, _ = run("--radius", "1.5")
+        self.assertNotIn("ssao: radius", text)
+        # A radius that cannot be one.
+        os.remove(self.output)
+        for bad in (0, -1.0, "2"):
+            with self.subTest(ao_distance=bad):
+                self.camera = self.write_camera(dict(CAMERA, ao_distance=bad))
+                self.assert_fails(self.run_ssao(), 1, "'ao_distance'")
+
     def test_ao_only_writes_one_channel(self):
         self.assert_ok(self.run_ssao("--ao-only"))
         names, out = read_image(self.output)

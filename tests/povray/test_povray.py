@@ -20,6 +20,7 @@ all).
 import argparse
 import math
 import os
+import re
 import shutil
 import subprocess
 import sys
@@ -520,7 +521,8 @@ class ExampleScenesTest(PovTestCase):
         """Runs the bridge on a copy of the example; checks what holds for any scene and returns
         (AO, Z, beauty, proc)."""
         scene = self.copy_example(relative, extra)
-        proc, names, pixels, keep = self.bridge_exr(scene, *args, size=size)
+        proc, names, pixels, keep = self.bridge_exr(scene, "--apply-to", "beauty", *args,
+                                                    size=size)
         for name in ["R", "G", "B", "A", "AO", "Z", "Radial"]:
             self.assertIn(name, names)
         ao = channel(names, pixels, "AO")
@@ -805,12 +807,113 @@ plane { y, -1 pigment { rgb 0.5 } }
 
 # ----------------------------------------------------------------------------------------------
 
+SW_AMBIENT = 0.8 * 0.2 * 1.5  # sunlit_wall.pov: pigment x finish ambient x ambient_light
+
+
+class AmbientModeTest(PovTestCase):
+    """--apply-to ambient (the default where the scene has ambient light): AO darkens only the
+    ambient term, rendered as its own pass; sunlit_wall.pov's is 0.24 everywhere."""
+
+    def run_mode(self, scene, mode, *args):
+        proc, names, pixels, keep = self.bridge_exr(scene, "--apply-to", mode, "--radius", "1",
+                                                    *args, name=mode)
+        rgb = np.stack([channel(names, pixels, c) for c in "RGB"], -1).astype(np.float64)
+        beauty = read_image(os.path.join(keep, "beauty.exr"))[1][..., :3].astype(np.float64)
+        ao = channel(names, pixels, "AO").astype(np.float64)
+        return proc, rgb, beauty, ao, np.isfinite(channel(names, pixels, "Z"))
+
+    def test_only_the_ambient_light_darkens(self):
+        scene = self.copy_scene("sunlit_wall.pov")
+        proc, out, beauty, ao, geometry = self.run_mode(scene, "auto")
+        text = proc.stdout + proc.stderr
+        self.assertIn("applied to the ambient light", text, self.detail(proc))
+        self.assertIn("ambient_light <1.5, 1.5, 1.5>", text, self.detail(proc))
+        self.assertNotIn("pre-pass", text)  # the camera's look_at places the fogs
+        # The darkening is (1 - AO) x the ambient term, which the scene fixes at 0.24.
+        occluded = geometry & (ao < 0.9)
+        self.assertGreater(int(occluded.sum()), 200)
+        ambient = (beauty - out)[occluded] / (1.0 - ao[occluded, None])
+        # Measured: 0.2400 +- 2e-4 (half floats in the passes).
+        np.testing.assert_allclose(ambient, SW_AMBIENT, rtol=0, atol=3e-3)
+        # Against --apply-to beauty (the whole image times AO): in the block's shadow the
+        # beauty is the ambient term alone, so both agree; in sunlight, the ambient mode darkens
+        # by a fraction 0.24 / beauty of the multiply mode's darkening.
+        proc, multiplied, _, ao_b, _ = self.run_mode(scene, "beauty")
+        self.assertIn("applied to the whole image", proc.stdout, self.detail(proc))
+        np.testing.assert_array_equal(ao, ao_b)
+        np.testing.assert_allclose(multiplied, beauty * ao[..., None], rtol=1e-5, atol=1e-6)
+        lum = beauty.mean(-1)
+        shade = occluded & (np.abs(lum - SW_AMBIENT) < 2e-3)
+        sun = occluded & (lum > 2.0 * SW_AMBIENT)
+        self.assertGreater(int(shade.sum()), 30, "no occluded pixel in the block's shadow")
+        self.assertGreater(int(sun.sum()), 100, "no occluded pixel in sunlight")
+        np.testing.assert_allclose(out[shade], multiplied[shade], rtol=0, atol=2e-3)
+        dark_ambient = (beauty - out).mean(-1)[sun]
+        dark_multiplied = (beauty - multiplied).mean(-1)[sun]
+        np.testing.assert_allclose(dark_ambient / dark_multiplied, SW_AMBIENT / lum[sun],
+                                   rtol=0.02)
+
+    def test_working_gamma(self):
+        # With assumed_gamma 2.2 POV-Ray writes (working value)^2.2: in the shadow the output is
+        # (0.24 AO)^2.2, i.e. the beauty times AO^2.2.
+        scene = self.copy_scene("sunlit_wall.pov")
+        proc, out, beauty, ao, geometry = self.run_mode(scene, "ambient", "Declare=Gamma=2.2")
+        lum = beauty.mean(-1)
+        shade = geometry & (ao < 0.9) & (np.abs(lum - SW_AMBIENT ** 2.2) < 2e-3)
+        self.assertGreater(int(shade.sum()), 30, self.detail(proc))
+        np.testing.assert_allclose(out[shade], beauty[shade] * ao[shade, None] ** 2.2, rtol=3e-3)
+
+    def test_scenes_without_ambient_light_multiply(self):
+        cases = [
+            ("radiosity", "global_settings { radiosity { } }", "uses radiosity"),
+            ("unreadable", "global_settings { ambient_light rgbf <1, 1, 1, 0> }",
+             "cannot read the scene's ambient_light"),
+            ("dark", "#default { finish { ambient 0 } }", "almost no ambient light"),
+        ]
+        for name, settings, phrase in cases:
+            with self.subTest(name):
+                scene = self.copy_scene(name + ".pov", f"""#version 3.7;
+{settings}
+camera {{ location <0, 2, -5> look_at <0, 0.5, 0> angle 50 }}
+light_source {{ <5, 8, -5> rgb 1 }}
+plane {{ y, 0 pigment {{ rgb 0.8 }} }}
+sphere {{ <0, 1, 0>, 1 pigment {{ rgb 0.8 }} }}
+""")
+                png = self.path(name + ".png")
+                proc = self.run_bridge(scene, "-o", png, "+W64", "+H48")
+                self.assert_ok(proc, png)
+                self.assertIn(phrase, proc.stdout + proc.stderr, self.detail(proc))
+                self.assertIn("applied to the whole image", proc.stdout, self.detail(proc))
+                if name != "dark":
+                    out = self.path(name + "-ambient.png")
+                    proc = self.run_bridge(scene, "-o", out, "+W64", "+H48", "--apply-to",
+                                           "ambient")
+                    self.assert_fails(proc, "--apply-to ambient", phrase, outputs=[out])
+
+    def test_default_radius_rule(self):
+        # 10% of the view's width at the median planar depth: 2 tan(55/2) x median x 0.1.
+        scene = self.copy_scene("sunlit_wall.pov")
+        png, exr = self.path("r.png"), self.path("r.exr")
+        proc = self.run_bridge(scene, "-o", png, "--exr", exr, f"+W{W}", f"+H{H}")
+        self.assert_ok(proc, png, exr)
+        names, pixels = read_image(exr)
+        z = channel(names, pixels, "Z")
+        median = float(np.median(z[np.isfinite(z)]))
+        expected = 0.1 * 2.0 * math.tan(math.radians(55.0) / 2.0) * median
+        match = re.search(r"radius ([0-9.]+) scene units \(10% of the view's width at the "
+                          r"median depth; --radius to change\)", proc.stdout)
+        self.assertIsNotNone(match, self.detail(proc))
+        self.assertAlmostEqual(float(match.group(1)), expected, delta=0.002 * expected)
+
+
+# ----------------------------------------------------------------------------------------------
+
 class PostProcessTest(PovTestCase):
     """--beauty IMAGE --depth DEPTH.exr: the AO of the full run from the same passes."""
 
     def test_post_process_matches_full_run(self):
         scene = self.copy_scene("analytic.pov")
-        proc, names, full, keep = self.bridge_exr(scene, "--radius", "1.5")
+        proc, names, full, keep = self.bridge_exr(scene, "--radius", "1.5", "--apply-to", "beauty")
         beauty = os.path.join(keep, "beauty.exr")
         for depth_channel, kind in [("Radial", "radial"), ("Z", "planar")]:
             out, exr = self.path(f"post-{kind}.png"), self.path(f"post-{kind}.exr")

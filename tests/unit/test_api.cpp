@@ -288,6 +288,104 @@ TEST(Api, CompositeIsBeautyTimesAoAndMayBeInPlace) {
   }
 }
 
+TEST(Api, AmbientCompositeDarkensOnlyTheAmbientPart) {
+  const Camera cam;
+  Scene s = floor_and_wall(cam);
+  const int w = s.width, h = s.height;
+  const auto ao = compute_ao(s, cam, 1.0, "hemisphere");
+  std::vector<float> beauty(size_t(w) * h * 4), ambient(beauty.size());
+  for (size_t i = 0; i < beauty.size(); ++i) {
+    beauty[i] = float(i % 13) / 13.0f;
+    ambient[i] = float(i % 7) / 7.0f;  // larger than the beauty in places: clamped at 0
+  }
+  std::vector<float> composite(beauty.size(), -1.0f);
+  Job job;
+  job.camera(cam);
+  job.set("normal_space", "camera");
+  job.image("depth", s.depth, w, h, 1);
+  job.image("normal", s.normal, w, h, 3);
+  job.image("beauty", beauty, w, h, 4);
+  job.image("ambient", ambient, w, h, 4);
+  job.image("composite", composite, w, h, 4);
+  ASSERT_EQ(job.run(), SSAO_OK) << ssao_last_error();
+  size_t darkened = 0, clamped = 0;
+  for (size_t i = 0; i < ao.size(); ++i) {
+    for (int c = 0; c < 3; ++c) {
+      const size_t k = i * 4 + size_t(c);
+      const float expected = std::max(0.0f, beauty[k] - (1.0f - ao[i]) * ambient[k]);
+      ASSERT_EQ(composite[k], expected) << "pixel " << i << " channel " << c;
+      darkened += composite[k] < beauty[k];
+      clamped += composite[k] == 0.0f && beauty[k] > 0.0f;
+    }
+    ASSERT_EQ(composite[i * 4 + 3], beauty[i * 4 + 3]);  // alpha untouched
+  }
+  EXPECT_GT(darkened, ao.size() / 10);  // the scene has occlusion to test
+  EXPECT_GT(clamped, 0u);
+
+  // The ambient image must have the beauty's channels.
+  std::vector<float> grey(size_t(w) * h);
+  ASSERT_EQ(ssao_job_set_image(job.get(), "ambient", grey.data(), w, h, 1, 0, 0), SSAO_OK);
+  EXPECT_EQ(job.run(), SSAO_ERROR_INVALID_ARGUMENT);
+  EXPECT_TRUE(contains(ssao_last_error(), "'ambient' has 1 channels but 'beauty' has 4"));
+}
+
+TEST(Api, AutoRadiusIsATenthOfTheViewWidthAtTheMedianDepth) {
+  // 60% of the columns at planar depth 2, the rest at 10, one column of sky: median 2.
+  Camera cam;
+  const int w = cam.width, h = cam.height;
+  std::vector<float> planar(size_t(w) * h), radial(planar.size());
+  for (int y = 0; y < h; ++y) {
+    for (int x = 0; x < w; ++x) {
+      const float d = x == w - 1 ? HUGE_VALF : (x < w * 6 / 10 ? 2.0f : 10.0f);
+      V3 origin, direction;
+      cam.ray(x, y, origin, direction);
+      planar[size_t(y) * w + x] = d;
+      radial[size_t(y) * w + x] = float(d * std::sqrt(dot(direction, direction)));
+    }
+  }
+  const double expected = 0.1 * 2.0 * cam.sensor / cam.lens;  // the view is 36/35 x depth wide
+  for (const bool is_radial : {false, true}) {
+    Job job;
+    job.camera(cam);
+    job.set("depth_kind", is_radial ? "radial" : "planar");
+    job.image("depth", is_radial ? radial : planar, w, h, 1);
+    double radius = 0.0;
+    ASSERT_EQ(ssao_job_auto_radius(job.get(), &radius), SSAO_OK) << ssao_last_error();
+    EXPECT_NEAR(radius, expected, 1e-6 * expected) << (is_radial ? "radial" : "planar");
+    double unchanged = 0.0;
+    ASSERT_EQ(ssao_job_get_float(job.get(), "radius", &unchanged), SSAO_OK);
+    EXPECT_EQ(unchanged, 1.0);  // the rule does not set the parameter
+  }
+  // Orthographic: a tenth of the view's width, whatever the depth.
+  Camera ortho;
+  ortho.ortho = true;
+  Job job;
+  job.camera(ortho);
+  job.image("depth", planar, w, h, 1);
+  double radius = 0.0;
+  ASSERT_EQ(ssao_job_auto_radius(job.get(), &radius), SSAO_OK);
+  EXPECT_NEAR(radius, 0.1 * ortho.ortho_scale, 1e-6);
+  // A portrait image: the larger side (the height) sets the extent.
+  Job portrait;
+  portrait.camera(cam);
+  std::vector<float> tall(size_t(w) * h, 4.0f);
+  portrait.image("depth", tall, h, w, 1);
+  ASSERT_EQ(ssao_job_auto_radius(portrait.get(), &radius), SSAO_OK);
+  EXPECT_NEAR(radius, 0.1 * 4.0 * cam.sensor / cam.lens, 1e-5);
+
+  // No depth, no geometry, no output pointer.
+  Job empty;
+  EXPECT_EQ(ssao_job_auto_radius(empty.get(), &radius), SSAO_ERROR_INVALID_OPERATION);
+  std::vector<float> sky(size_t(w) * h, HUGE_VALF);
+  sky[5] = std::nanf("");
+  sky[6] = -1.0f;
+  empty.image("depth", sky, w, h, 1);
+  EXPECT_EQ(ssao_job_auto_radius(empty.get(), &radius), SSAO_ERROR_INVALID_OPERATION);
+  EXPECT_TRUE(contains(ssao_last_error(), "no geometry"));
+  EXPECT_EQ(ssao_job_auto_radius(job.get(), nullptr), SSAO_ERROR_INVALID_ARGUMENT);
+  EXPECT_EQ(ssao_job_auto_radius(nullptr, &radius), SSAO_ERROR_INVALID_ARGUMENT);
+}
+
 TEST(Api, StrengthPowerAndRemapShapeTheResult) {
   const Camera cam;
   Scene s = floor_and_wall(cam);

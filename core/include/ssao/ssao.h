@@ -139,15 +139,25 @@ SSAO_API ssao_status ssao_job_get_floats(ssao_job job, const char* name, double*
  *   "normal"    input, optional, channels 0..2 read (space given by "normal_space"); without it,
  *               normals are reconstructed from depth
  *   "beauty"    input, 1..4 channels, needed by "composite"
+ *   "ambient"   input, optional, as many channels as "beauty": the part of the beauty that AO
+ *               darkens (light that does not come straight from a light source)
  *   "ao"        output: AO written to channels 0..min(channels,3)-1, channel 3 (if any) set to 1
- *   "composite" output: beauty with its first min(channels,3) channels multiplied by AO, the
- *               rest copied; needs as many channels as "beauty" (may be the beauty buffer itself)
+ *   "composite" output: beauty with its first min(channels,3) channels multiplied by AO, or,
+ *               with "ambient", beauty - (1 - AO) x ambient (not below 0 where the beauty is
+ *               not); the rest copied; needs as many channels as "beauty" (may be the beauty
+ *               buffer itself)
  * All images of a job must have the depth image's width and height. */
 SSAO_API ssao_status ssao_job_set_image(ssao_job job, const char* name, float* data, int width,
                                         int height, int channels, ptrdiff_t pixel_stride,
                                         ptrdiff_t row_stride);
 /* Sets (or, with fn == NULL, clears) the progress callback. */
 SSAO_API ssao_status ssao_job_set_progress(ssao_job job, ssao_progress_fn fn, void* user);
+/* The automatic radius (scene units) for the attached depth image and the job's camera
+ * parameters, depth_kind, background_depth and clip_end: 10% of the view's extent along the
+ * image's larger side at the median depth of the geometry pixels (orthographic: 10% of that
+ * extent). It does not set "radius". SSAO_ERROR_INVALID_OPERATION without a depth image or
+ * when no pixel has geometry. Calibration: docs/parameters.md. */
+SSAO_API ssao_status ssao_job_auto_radius(ssao_job job, double* out);
 /* Computes AO and writes the attached outputs. A 0 x 0 image is valid and does nothing. */
 SSAO_API ssao_status ssao_job_run(ssao_job job);
 

@@ -1,0 +1,318 @@
+// SPDX-License-Identifier: MIT
+// Image files through OpenImageIO, built as a module (libssao_image_codec.so) that ssao_io loads
+// on first use (image_io.cpp): OpenImageIO brings about 260 shared libraries, whose loading
+// costs 0.2 s at start-up. Loaded later, that time overlaps other work (povray-ssao starts
+// POV-Ray first). Errors cross the module boundary as messages, not exceptions.
+#include "io/image_codec.h"
+
+#include <OpenImageIO/imageio.h>
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cctype>
+#include <cerrno>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
+#include <limits>
+#include <memory>
+#include <new>
+#include <system_error>
+
+namespace fs = std::filesystem;
+
+namespace ssao_io {
+namespace {
+
+std::string quoted(const std::string& path) { return "'" + path + "'"; }
+
+// OIIO's messages may end with a newline or be empty.
+std::string oiio_detail(std::string message) {
+  while (!message.empty() && (message.back() == '\n' || message.back() == ' ')) message.pop_back();
+  return message.empty() ? std::string("no details from OpenImageIO") : "OpenImageIO: " + message;
+}
+
+void require_readable_file(const std::string& path) {
+  std::error_code ec;
+  const fs::file_status status = fs::status(path, ec);
+  if (!fs::exists(status)) throw Error("cannot read " + quoted(path) + ": no such file");
+  if (fs::is_directory(status)) throw Error("cannot read " + quoted(path) + ": it is a directory");
+  if (::access(path.c_str(), R_OK) != 0) {
+    throw Error("cannot read " + quoted(path) + ": " + std::strerror(errno));
+  }
+}
+
+size_t checked_float_count(int width, int height, int channels, const std::string& path) {
+  if (width < 0 || height < 0 || channels <= 0) {
+    throw Error("cannot read " + quoted(path) + ": invalid image size " + std::to_string(width) +
+                " x " + std::to_string(height) + " x " + std::to_string(channels) + " channels");
+  }
+  const size_t limit = std::numeric_limits<size_t>::max() / sizeof(float);
+  size_t count = static_cast<size_t>(width);
+  for (const int factor : {height, channels}) {
+    if (factor != 0 && count > limit / static_cast<size_t>(factor)) {
+      throw Error("cannot read " + quoted(path) + ": image too large");
+    }
+    count *= static_cast<size_t>(factor);
+  }
+  return count;
+}
+
+// A temporary file next to the final one, removed on destruction unless committed.
+class TemporaryFile {
+ public:
+  explicit TemporaryFile(const std::string& final_path) {
+    const fs::path final_fs(final_path);
+    fs::path folder = final_fs.parent_path();
+    if (folder.empty()) folder = ".";
+    std::string pattern = (folder / ("." + final_fs.filename().string() + ".XXXXXX.tmp")).string();
+    std::vector<char> buffer(pattern.begin(), pattern.end());
+    buffer.push_back('\0');
+    fd_ = ::mkstemps(buffer.data(), 4);
+    if (fd_ < 0) {
+      throw Error("cannot write " + quoted(final_path) + ": cannot create a file in folder " +
+                  quoted(folder.string()) + ": " + std::strerror(errno));
+    }
+    path_ = buffer.data();
+    // mkstemps creates the file with mode 0600; give it the permissions of a normal new file.
+    const mode_t mask = ::umask(0);
+    ::umask(mask);
+    (void)::fchmod(fd_, static_cast<mode_t>(0666 & ~mask));
+  }
+  TemporaryFile(const TemporaryFile&) = delete;
+  TemporaryFile& operator=(const TemporaryFile&) = delete;
+  ~TemporaryFile() {
+    if (fd_ >= 0) ::close(fd_);
+    if (!committed_) ::unlink(path_.c_str());
+  }
+
+  const std::string& path() const { return path_; }
+
+  // Flushes the (already closed by its writer) file to disk and renames it to `final_path`.
+  void commit(const std::string& final_path) {
+    if (::fsync(fd_) != 0) {
+      throw Error("cannot write " + quoted(final_path) + ": " + std::strerror(errno));
+    }
+    ::close(fd_);
+    fd_ = -1;
+    if (std::rename(path_.c_str(), final_path.c_str()) != 0) {
+      throw Error("cannot write " + quoted(final_path) + ": " + std::strerror(errno));
+    }
+    committed_ = true;
+  }
+
+ private:
+  std::string path_;
+  int fd_ = -1;
+  bool committed_ = false;
+};
+
+// A multi-part EXR (Blender 5.x writes a multilayer file as one part per layer) reads as one
+// image with the channels of every part, in file order. Parts of another size are refused.
+void append_exr_parts(OIIO::ImageInput& input, const std::string& path, Image& image) {
+  for (int part = 1; input.seek_subimage(part, 0); ++part) {
+    const OIIO::ImageSpec spec = input.spec();
+    if (spec.width != image.width || spec.height != image.height || spec.x != 0 || spec.y != 0 ||
+        spec.deep || spec.depth > 1) {
+      throw Error("cannot read " + quoted(path) + ": its part " + std::to_string(part) + " (" +
+                  std::string(spec.get_string_attribute("name")) +
+                  ") is not the size of the first");
+    }
+    const int old_channels = image.channels();
+    const int channels = old_channels + spec.nchannels;
+    const size_t pixels = image.pixel_count();
+    std::vector<float> part_pixels(
+        checked_float_count(spec.width, spec.height, spec.nchannels, path));
+    if (!input.read_image(part, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, part_pixels.data())) {
+      throw Error("cannot read " + quoted(path) + ": the file is truncated or corrupt (" +
+                  oiio_detail(input.geterror()) + ")");
+    }
+    std::vector<float> merged(checked_float_count(image.width, image.height, channels, path));
+    for (size_t i = 0; i < pixels; ++i) {
+      std::copy_n(&image.pixels[i * old_channels], old_channels, &merged[i * channels]);
+      std::copy_n(&part_pixels[i * spec.nchannels], spec.nchannels,
+                  &merged[i * channels + old_channels]);
+    }
+    image.pixels.swap(merged);
+    for (int c = 0; c < spec.nchannels; ++c) image.channel_names.push_back(spec.channel_name(c));
+  }
+}
+
+Image read(const std::string& path) {
+  require_readable_file(path);
+  auto input = OIIO::ImageInput::open(path);
+  if (!input) {
+    throw Error("cannot read " + quoted(path) + ": not an image file OpenImageIO can read, or " +
+                "its header is damaged (" + oiio_detail(OIIO::geterror()) + ")");
+  }
+  const OIIO::ImageSpec spec = input->spec();
+  if (spec.deep) throw Error("cannot read " + quoted(path) + ": deep images are not supported");
+  if (spec.depth > 1)
+    throw Error("cannot read " + quoted(path) + ": volume images are not supported");
+  if (spec.x != spec.full_x || spec.y != spec.full_y || spec.width != spec.full_width ||
+      spec.height != spec.full_height) {
+    throw Error("cannot read " + quoted(path) + ": its data window (" + std::to_string(spec.width) +
+                " x " + std::to_string(spec.height) + " at " + std::to_string(spec.x) + ", " +
+                std::to_string(spec.y) + ") differs from its display window (" +
+                std::to_string(spec.full_width) + " x " + std::to_string(spec.full_height) +
+                "); crop or pad it to the full frame first");
+  }
+
+  Image image;
+  image.width = spec.width;
+  image.height = spec.height;
+  image.color_space = spec.get_string_attribute("oiio:ColorSpace");
+  const size_t count = checked_float_count(spec.width, spec.height, spec.nchannels, path);
+  for (int c = 0; c < spec.nchannels; ++c) image.channel_names.push_back(spec.channel_name(c));
+  try {
+    image.pixels.resize(count);
+  } catch (const std::bad_alloc&) {
+    throw Error("cannot read " + quoted(path) + ": out of memory for " +
+                std::to_string(spec.width) + " x " + std::to_string(spec.height) + " x " +
+                std::to_string(spec.nchannels) + " floats");
+  }
+  const bool ok =
+      input->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, image.pixels.data());
+  if (!ok) {
+    throw Error("cannot read " + quoted(path) + ": the file is truncated or corrupt (" +
+                oiio_detail(input->geterror()) + ")");
+  }
+  if (std::string(input->format_name()) == "openexr") append_exr_parts(*input, path, image);
+  input->close();
+  return image;
+}
+
+void check_image_buffer(const std::string& path, int width, int height, int channels,
+                        size_t float_count) {
+  if (width <= 0 || height <= 0 || channels <= 0) {
+    throw Error("cannot write " + quoted(path) + ": empty image (" + std::to_string(width) + " x " +
+                std::to_string(height) + " x " + std::to_string(channels) + " channels)");
+  }
+  if (float_count != checked_float_count(width, height, channels, path)) {
+    throw Error("cannot write " + quoted(path) + ": internal error: pixel buffer has " +
+                std::to_string(float_count) + " floats for " + std::to_string(width) + " x " +
+                std::to_string(height) + " x " + std::to_string(channels));
+  }
+  if (fs::is_directory(path)) throw Error("cannot write " + quoted(path) + ": it is a directory");
+}
+
+// Writes through a temporary file in the same folder, renamed into place once complete.
+void write_atomically(const std::string& path, const char* format, const OIIO::ImageSpec& spec,
+                      OIIO::TypeDesc data_type, const void* data) {
+  TemporaryFile temporary(path);
+  auto output = OIIO::ImageOutput::create(format);
+  if (!output) {
+    throw Error("cannot write " + quoted(path) + ": no " + format + " writer (" +
+                oiio_detail(OIIO::geterror()) + ")");
+  }
+  bool ok = output->open(temporary.path(), spec) && output->write_image(data_type, data);
+  ok = output->close() && ok;
+  if (!ok) {
+    throw Error("cannot write " + quoted(path) + ": " + oiio_detail(output->geterror()));
+  }
+  temporary.commit(path);
+}
+
+// The sRGB transfer function (IEC 61966-2-1) applied to linear scene values clamped to [0, 1].
+float srgb_encode(float linear) {
+  const float v = std::clamp(std::isfinite(linear) ? linear : 0.0f, 0.0f, 1.0f);
+  return v <= 0.0031308f ? 12.92f * v : 1.055f * std::pow(v, 1.0f / 2.4f) - 0.055f;
+}
+
+void write_exr_file(const std::string& path, int width, int height,
+                    const std::vector<std::string>& channel_names,
+                    const std::vector<float>& pixels) {
+  const int channels = static_cast<int>(channel_names.size());
+  check_image_buffer(path, width, height, channels, pixels.size());
+  OIIO::ImageSpec spec(width, height, channels, OIIO::TypeDesc::FLOAT);
+  spec.channelnames = channel_names;
+  spec.alpha_channel = -1;
+  for (int c = 0; c < channels; ++c) {
+    if (channel_names[static_cast<size_t>(c)] == "A") spec.alpha_channel = c;
+  }
+  spec.attribute("compression", "zip");
+  write_atomically(path, "openexr", spec, OIIO::TypeDesc::FLOAT, pixels.data());
+}
+
+void write_preview_file(const std::string& path, int width, int height,
+                        const std::vector<std::string>& channel_names,
+                        const std::vector<float>& pixels) {
+  const int channels = static_cast<int>(channel_names.size());
+  check_image_buffer(path, width, height, channels, pixels.size());
+  auto index_of = [&](const char* name) {
+    const auto it = std::find(channel_names.begin(), channel_names.end(), name);
+    return it == channel_names.end() ? -1 : static_cast<int>(it - channel_names.begin());
+  };
+  // Colour if there is R, G, B (and A); otherwise the AO (or first) channel as grey.
+  std::vector<int> picked;
+  for (const char* name : {"R", "G", "B"}) {
+    if (index_of(name) >= 0) picked.push_back(index_of(name));
+  }
+  if (picked.size() != 3) picked = {std::max(0, index_of("AO"))};
+  const int alpha = picked.size() == 3 ? index_of("A") : -1;
+  const int out_channels = static_cast<int>(picked.size()) + (alpha >= 0 ? 1 : 0);
+
+  const std::string extension = fs::path(path).extension().string();
+  std::string format = extension.empty() ? "" : extension.substr(1);
+  std::transform(format.begin(), format.end(), format.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  if (format == "jpg") format = "jpeg";
+  if (format == "tif") format = "tiff";
+
+  const size_t count = static_cast<size_t>(width) * static_cast<size_t>(height);
+  std::vector<unsigned char> bytes(count * static_cast<size_t>(out_channels));
+  for (size_t p = 0; p < count; ++p) {
+    const float* in = pixels.data() + p * static_cast<size_t>(channels);
+    unsigned char* out = bytes.data() + p * static_cast<size_t>(out_channels);
+    for (size_t k = 0; k < picked.size(); ++k) {
+      out[k] = static_cast<unsigned char>(std::lround(255.0f * srgb_encode(in[picked[k]])));
+    }
+    if (alpha >= 0) {
+      const float a = std::isfinite(in[alpha]) ? std::clamp(in[alpha], 0.0f, 1.0f) : 1.0f;
+      out[picked.size()] = static_cast<unsigned char>(std::lround(255.0f * a));
+    }
+  }
+  OIIO::ImageSpec spec(width, height, out_channels, OIIO::TypeDesc::UINT8);
+  spec.alpha_channel = alpha >= 0 ? out_channels - 1 : -1;
+  spec.attribute("oiio:ColorSpace", "sRGB");
+  write_atomically(path, format.c_str(), spec, OIIO::TypeDesc::UINT8, bytes.data());
+}
+
+// Runs `work`, turning any exception into a message.
+template <typename Work>
+bool guarded(std::string& error, Work&& work) {
+  try {
+    work();
+    return true;
+  } catch (const std::bad_alloc&) {
+    error = "out of memory";
+  } catch (const std::exception& e) {
+    error = e.what();
+  }
+  return false;
+}
+
+const ImageCodec kCodec = {
+    [](const std::string& path, Image& image, std::string& error) {
+      return guarded(error, [&] { image = read(path); });
+    },
+    [](const std::string& path, int width, int height, const std::vector<std::string>& names,
+       const std::vector<float>& pixels, std::string& error) {
+      return guarded(error, [&] { write_exr_file(path, width, height, names, pixels); });
+    },
+    [](const std::string& path, int width, int height, const std::vector<std::string>& names,
+       const std::vector<float>& pixels, std::string& error) {
+      return guarded(error, [&] { write_preview_file(path, width, height, names, pixels); });
+    },
+};
+
+}  // namespace
+}  // namespace ssao_io
+
+extern "C" __attribute__((visibility("default"))) const ssao_io::ImageCodec* ssao_io_image_codec() {
+  return &ssao_io::kCodec;
+}
