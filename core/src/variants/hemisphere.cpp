@@ -13,6 +13,8 @@
 #include <hwy/foreach_target.h>  // re-includes this file once per target
 #include <hwy/highway.h>
 
+#include "variants/frame_simd-inl.h"
+
 #ifndef SSAO_HEMISPHERE_ROW_ARGS
 #define SSAO_HEMISPHERE_ROW_ARGS
 #include <algorithm>
@@ -102,17 +104,8 @@ void hemisphere_row(const HemisphereRowArgs& a, int y, int x0, int x1, float* ou
     const VF py = view_y_of_row * scale_v * depth_scale;
     const VF pz = hn::Neg(safe_depth);
 
-    // Octahedral normal decode (see decode_normal in frame.h).
-    const VI packed = hn::Load(di, normal_in);
-    const VF scale16 = hn::Set(df, 1.0f / 32767.0f);
-    const VF ou = hn::ConvertTo(df, hn::ShiftRight<16>(hn::ShiftLeft<16>(packed))) * scale16;
-    const VF ov = hn::ConvertTo(df, hn::ShiftRight<16>(packed)) * scale16;
-    VF nz = one - hn::Abs(ou) - hn::Abs(ov);
-    const auto folded = hn::Lt(nz, zero);
-    VF nx = hn::IfThenElse(folded, hn::CopySign(one - hn::Abs(ov), ou), ou);
-    VF ny = hn::IfThenElse(folded, hn::CopySign(one - hn::Abs(ou), ov), ov);
-    const VF inv_length = one / hn::Sqrt(nx * nx + ny * ny + nz * nz);
-    nx = nx * inv_length, ny = ny * inv_length, nz = nz * inv_length;
+    VF nx, ny, nz;
+    decode_normals(df, hn::Load(di, normal_in), nx, ny, nz);
 
     // Tangent frame (orthonormal_basis in vec3.h).
     const VF sign = hn::CopySign(one, nz);
