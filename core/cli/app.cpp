@@ -7,10 +7,12 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <future>
 #include <string>
 
 #include "io/blender_passes.h"
 #include "io/camera_json.h"
+#include "io/frames.h"
 #include "io/image_io.h"
 #include "io/job.h"
 #include "progress.h"
@@ -181,12 +183,12 @@ bool is_geometry(float depth, double background_depth, double clip_end) {
          (clip_end <= 0.0 || depth < clip_end);
 }
 
-void print_summary(const Options& options, const ssao_io::Job& job, const Inputs& in,
-                   const Outputs& out, double milliseconds) {
+// Mean AO over the geometry pixels ("n/a" without any) and their count.
+std::string mean_ao(const ssao_io::Job& job, const Inputs& in, const Outputs& out, size_t& count) {
   const double background_depth = job.get_float("background_depth");
   const double clip_end = job.get_float("clip_end");
   double sum = 0.0;
-  size_t count = 0;
+  count = 0;
   for (size_t p = 0; p < in.depth.size(); ++p) {
     if (!is_geometry(in.depth[p], background_depth, clip_end)) continue;
     sum += out.ao[p];
@@ -194,12 +196,19 @@ void print_summary(const Options& options, const ssao_io::Job& job, const Inputs
   }
   char mean[64] = "n/a";
   if (count > 0) std::snprintf(mean, sizeof mean, "%.4f", sum / static_cast<double>(count));
+  return mean;
+}
+
+void print_summary(const Options& options, const ssao_io::Job& job, const Inputs& in,
+                   const Outputs& out, double milliseconds) {
+  size_t count = 0;
+  const std::string mean = mean_ao(job, in, out, count);
   std::fprintf(stderr,
                "ssao: %s: %dx%d, variant %s, normals %s, %.1f ms, mean AO %s over "
                "%zu geometry pixels\n",
                options.output.c_str(), in.image.width, in.image.height,
                job.settings_summary().c_str(), in.normal.empty() ? "from depth" : "from pass",
-               milliseconds, mean, count);
+               milliseconds, mean.c_str(), count);
 }
 
 // Without --radius: the camera file's ao_distance, else the core's automatic rule; said on
@@ -225,9 +234,204 @@ void choose_radius(const Options& options, const ssao_io::Camera& camera, ssao_i
   }
 }
 
+// One frame of a sequence, read ahead while the previous one computes.
+struct FrameInputs {
+  ssao_io::Camera camera;
+  Inputs in;
+};
+
+Options frame_options(const Options& options, const ssao_io::FramePattern& input,
+                      const ssao_io::FramePattern& output, const ssao_io::FramePattern& camera,
+                      int frame) {
+  Options o = options;
+  o.input = input.path(frame);
+  o.output = output.path(frame);
+  o.camera = camera.path(frame);
+  o.quiet = true;  // per-frame warnings would interleave with the frame lines
+  return o;
+}
+
+std::string duration_text(double seconds) {
+  char buffer[64];
+  const long total = std::lround(seconds);
+  if (total >= 3600) {
+    std::snprintf(buffer, sizeof buffer, "%ldh %02ldm", total / 3600, total / 60 % 60);
+  } else if (total >= 60) {
+    std::snprintf(buffer, sizeof buffer, "%ldm %02lds", total / 60, total % 60);
+  } else {
+    std::snprintf(buffer, sizeof buffer, "%.1fs", seconds);
+  }
+  return buffer;
+}
+
+std::string json_string(const std::string& text) {
+  std::string out = "\"";
+  for (const char c : text) {
+    if (c == '"' || c == '\\') {
+      out += '\\';
+      out += c;
+    } else if (static_cast<unsigned char>(c) < 0x20) {
+      char buffer[8];
+      std::snprintf(buffer, sizeof buffer, "\\u%04x", c);
+      out += buffer;
+    } else {
+      out += c;
+    }
+  }
+  return out + "\"";
+}
+
+// --frames: every frame independently; the failures are reported and listed at the end.
+void run_sequence(const Options& options) {
+  const ssao_io::FramePattern input(options.input), output(options.output);
+  // A camera file that exists under its own name serves every frame (its name may hold '@').
+  const ssao_io::FramePattern camera = fs::is_regular_file(options.camera)
+                                           ? ssao_io::FramePattern::literal(options.camera)
+                                           : ssao_io::FramePattern(options.camera);
+  if (!input.has_frame() || !output.has_frame()) {
+    throw UsageError(std::string("with --frames, ") + (input.has_frame() ? "-o" : "the input") +
+                     " needs a frame placeholder (#### for 4 digits, @, or %04d)");
+  }
+  bool radius_given = false;
+  for (const ParamSetting& setting : options.params) radius_given |= setting.name == "radius";
+  if (!radius_given) {
+    // Every frame must get the same radius, whichever machine or chunk renders it.
+    const Options first = frame_options(options, input, output, camera, options.frames.front());
+    if (!(load_camera(first).ao_distance > 0.0)) {
+      throw UsageError("a sequence needs --radius R, or \"ao_distance\" in its camera file ('" +
+                       first.camera + "'): the automatic radius follows each frame's depth");
+    }
+  }
+
+  ProgressReporter interrupt(true);  // Ctrl-C stops after the frame in progress
+  ssao_io::Job job;
+  const size_t total = options.frames.size();
+  std::vector<int> failed;
+  size_t written = 0, skipped = 0;
+  const auto start = std::chrono::steady_clock::now();
+  double compute_seconds = 0.0;
+
+  auto load = [](Options o) {
+    FrameInputs f;
+    f.camera = load_camera(o);
+    f.in = load_inputs(o);
+    return f;
+  };
+  auto wanted = [&](size_t i) {
+    return !(options.skip_existing && fs::exists(output.path(options.frames[i])));
+  };
+  std::future<FrameInputs> next;
+  auto prefetch = [&](size_t i) {
+    while (i < total && !wanted(i)) ++i;  // skipped frames are not read
+    if (i < total) {
+      next = std::async(std::launch::async, load,
+                        frame_options(options, input, output, camera, options.frames[i]));
+    }
+    return i;
+  };
+  size_t next_index = prefetch(0);
+
+  for (size_t i = 0; i < total; ++i) {
+    const int frame = options.frames[i];
+    const Options o = frame_options(options, input, output, camera, frame);
+    std::string status = "ok", error, mean = "n/a";
+    double seconds = 0.0;
+    if (i != next_index) {  // prefetch() passed over it: its output exists
+      status = "skipped";
+      ++skipped;
+    } else {
+      const auto frame_start = std::chrono::steady_clock::now();
+      try {
+        FrameInputs f = next.get();
+        next_index = prefetch(i + 1);  // read the next frame while this one computes
+        refuse_overwriting_inputs(o);
+        check_output_folder(o);
+        ssao_io::apply_camera(job.get(), f.camera, o.camera);
+        ssao_io::apply_params(job, o.params);
+        Outputs out;
+        attach_images(job, f.in, out);
+        choose_radius(o, f.camera, job);
+        job.set_progress(&ProgressReporter::callback, &interrupt);
+        const ssao_status result = ssao_job_run(job.get());
+        job.set_progress(nullptr, nullptr);
+        if (result == SSAO_ERROR_CANCELLED || ProgressReporter::interrupted()) {
+          throw ssao_io::Error("interrupted");
+        }
+        ssao_io::check_status(result, "SSAO failed");
+        write_output(o, f.in, out);
+        size_t count = 0;
+        mean = mean_ao(job, f.in, out, count);
+        ++written;
+      } catch (const std::exception& e) {
+        status = "failed";
+        error = e.what();
+        failed.push_back(frame);
+        if (i + 1 < total && next_index <= i) next_index = prefetch(i + 1);
+      }
+      seconds =
+          std::chrono::duration<double>(std::chrono::steady_clock::now() - frame_start).count();
+      compute_seconds += seconds;
+    }
+    const size_t done = i + 1;
+    const size_t computed = written + failed.size();
+    // Frames still to do, at the mean time of those computed so far.
+    const double left =
+        computed > 0 ? compute_seconds / double(computed) * double(total - done) : 0.0;
+    if (options.json_progress) {
+      std::fprintf(
+          stderr,
+          "{\"frame\": %d, \"index\": %zu, \"total\": %zu, \"status\": \"%s\", "
+          "\"seconds\": %.3f, \"mean_ao\": %s, \"eta_seconds\": %.1f, \"output\": %s%s%s}\n",
+          frame, done, total, status.c_str(), seconds, mean == "n/a" ? "null" : mean.c_str(), left,
+          json_string(o.output).c_str(),
+          error.empty() ? "" : ", \"error\": ", error.empty() ? "" : json_string(error).c_str());
+    } else if (!options.quiet || status == "failed") {
+      if (status == "failed") {
+        std::fprintf(stderr, "ssao: frame %d (%zu/%zu): error: %s\n", frame, done, total,
+                     error.c_str());
+      } else if (status == "skipped") {
+        std::fprintf(stderr, "ssao: frame %d (%zu/%zu): skipped, %s exists\n", frame, done, total,
+                     o.output.c_str());
+      } else {
+        std::fprintf(stderr, "ssao: frame %d (%zu/%zu): %s in %.2f s, mean AO %s; %s left\n", frame,
+                     done, total, o.output.c_str(), seconds, mean.c_str(),
+                     duration_text(left).c_str());
+      }
+    }
+    std::fflush(stderr);
+    if (ProgressReporter::interrupted()) {
+      if (next.valid()) next.wait();
+      throw ssao_io::Error("interrupted after frame " + std::to_string(frame) + ": " +
+                           std::to_string(written) + " frames written");
+    }
+  }
+  const double wall =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  if (!options.quiet || !failed.empty()) {
+    std::string list;
+    for (size_t k = 0; k < failed.size() && k < 50; ++k) {
+      list += (k ? "," : "") + std::to_string(failed[k]);
+    }
+    if (failed.size() > 50) list += ",...";
+    std::fprintf(stderr, "ssao: %zu of %zu frames written in %s (%.1f frames per minute)%s%s%s\n",
+                 written, total, duration_text(wall).c_str(),
+                 wall > 0.0 ? 60.0 * double(written) / wall : 0.0,
+                 skipped ? (", " + std::to_string(skipped) + " skipped").c_str() : "",
+                 failed.empty() ? "" : "; failed: ", list.c_str());
+  }
+  if (!failed.empty()) {
+    throw SequenceFailed(std::to_string(failed.size()) + " of " + std::to_string(total) +
+                         " frames failed");
+  }
+}
+
 }  // namespace
 
 void run_ssao(const Options& options) {
+  if (!options.frames.empty()) {
+    run_sequence(options);
+    return;
+  }
   refuse_overwriting_inputs(options);
   check_output_folder(options);
   const ssao_io::Camera camera = load_camera(options);

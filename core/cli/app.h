@@ -5,12 +5,21 @@
 #include <vector>
 
 #include "args.h"
+#include "io/error.h"
 
 namespace ssao_cli {
 
+// A sequence in which some frames failed (each was reported; the others were written).
+class SequenceFailed : public ssao_io::Error {
+ public:
+  using ssao_io::Error::Error;
+};
+
 // Reads the input and the camera, computes AO and writes the output. Throws UsageError for
 // command-line mistakes found late (output = input, a value the core rejects), ssao_io::Error for
-// any other failure; in both cases nothing has been written under the output name.
+// any other failure; in both cases nothing has been written under the output name. With
+// --frames, every frame is done on its own (a line per frame on stderr) and SequenceFailed
+// reports the frames that failed after the others were written.
 void run_ssao(const Options& options);
 
 }  // namespace ssao_cli

@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "io/camera_json.h"
+#include "io/frames.h"
 
 namespace ssao_cli {
 namespace {
@@ -44,6 +45,30 @@ const std::vector<FrontOption>& front_options() {
        "camera description (required): Blender camera properties and matrix_world, see "
        "docs/conventions.md",
        [](Options& o, const std::string&, const std::string& v) { o.camera = v; }},
+      {kInputOutput, "--frames", nullptr, "SPEC",
+       "process a sequence: IN.exr, -o and --camera are patterns with one frame placeholder "
+       "(#### = 4 digits, @ = 1 digit, %04d; a camera without one serves every frame); SPEC is "
+       "A, A-B, A-BxN (every Nth) or a comma-separated list of those, e.g. 1001-1100 or "
+       "1,5,9-12. A frame that fails is reported and the others are still written",
+       [](Options& o, const std::string& f, const std::string& v) {
+         try {
+           o.frames = ssao_io::parse_frames(v);
+         } catch (const ssao_io::Error& e) {
+           throw UsageError(std::string(e.what()) + " (" + f + ")");
+         }
+         o.frames_text = v;
+       }},
+      {kInputOutput, "--skip-existing", nullptr, nullptr,
+       "with --frames: leave frames whose output exists (outputs are written atomically, so a "
+       "killed run leaves no half frame)",
+       [](Options& o, const std::string&, const std::string&) { o.skip_existing = true; }},
+      {kOther, "--progress", nullptr, "text|json",
+       "with --frames: a line per frame on stderr, as text (default) or one JSON object per line",
+       [](Options& o, const std::string& f, const std::string& v) {
+         if (v != "text" && v != "json")
+           throw UsageError(f + " must be text or json, got '" + v + "'");
+         o.json_progress = v == "json";
+       }},
       {kInputOutput, "--ao-only", nullptr, nullptr,
        "write exactly one channel, AO, instead of beauty x AO + AO",
        [](Options& o, const std::string&, const std::string&) { o.ao_only = true; }},
@@ -84,6 +109,9 @@ void require_complete(const Options& options) {
   if (options.no_normals && !options.normal_channels.empty()) {
     throw UsageError("--no-normals and --normal-channels contradict each other");
   }
+  if (options.frames.empty() && (options.skip_existing || options.json_progress)) {
+    throw UsageError("--skip-existing and --progress apply to sequences (--frames)");
+  }
 }
 
 }  // namespace
@@ -118,13 +146,16 @@ Options parse_args(int argc, const char* const* argv, const std::vector<ssao_par
 std::string usage_text(const std::vector<ssao_param_desc>& table) {
   std::string text =
       "Usage: ssao IN.exr -o OUT.exr --camera CAM.json [options]\n"
+      "       ssao 'IN.####.exr' -o 'OUT.####.exr' --camera 'CAM[.####].json' --frames A-B\n"
+      "            --radius R [options]\n"
       "\n"
       "Screen-space ambient occlusion of a rendered image. Reads Blender's multilayer EXR\n"
       "(<layer>.Depth.Z, <layer>.Normal.X/Y/Z, <layer>.Combined.R/G/B/A; other files with\n"
       "plain channel names work too) and writes OUT.exr with R,G,B[,A] = beauty x AO (alpha\n"
       "copied) and an AO channel (1 = unoccluded), or only AO with --ao-only.\n"
       "Without --radius, the radius is the camera file's \"ao_distance\", else 10% of the\n"
-      "view's width at the median depth (printed).\n"
+      "view's width at the median depth (printed); a sequence needs --radius or ao_distance,\n"
+      "so that its frames share one radius.\n"
       "\n"
       "Input and output:\n";
   text += help_entry("IN.exr", "input image (any file OpenImageIO reads)");

@@ -32,6 +32,11 @@ struct Options {
   std::vector<std::string> normal_channels;
   std::vector<std::string> beauty_channels;
   std::vector<ParamSetting> params;  // in command-line order
+  // Sequences: IN, -o and --camera are patterns (#, @, %04d) with --frames.
+  std::vector<int> frames;  // empty: one file
+  std::string frames_text;
+  bool skip_existing = false;
+  bool json_progress = false;
 };
 
 // Parses argv. With --help or --version anywhere, only that flag is honoured. Throws UsageError

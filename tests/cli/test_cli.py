@@ -375,6 +375,106 @@ class BackgroundDepthTest(CliTestCase):
         np.testing.assert_allclose(out[:, :, 0][wall], 1.0, rtol=0, atol=1e-6)
 
 
+class SequenceTest(CliTestCase):
+    """--frames: patterns, independent frames, --skip-existing, --progress json."""
+
+    def write_frames(self, frames, pattern="in.{:04d}.exr"):
+        """Frames whose box sits at a different depth each (so that they differ)."""
+        for frame in frames:
+            planes = {k: v.copy() for k, v in self.planes.items()}
+            box = planes["ViewLayer.Depth.Z"] == BOX_DEPTH
+            planes["ViewLayer.Depth.Z"][box] = BOX_DEPTH + 0.3 * frame
+            write_exr(self.path(pattern.format(frame)), planes, BLENDER_CHANNELS)
+
+    def run_sequence(self, *args, inp="in.####.exr", out="out.####.exr"):
+        return self.run_ssao(self.path(inp), "-o", self.path(out), "--camera", self.camera,
+                             "--radius", str(RADIUS), *args, default_paths=False)
+
+    def test_frames_are_independent_and_match_single_runs(self):
+        self.write_frames([1, 2, 4])
+        whole = open(self.path("in.0001.exr"), "rb").read()
+        with open(self.path("in.0005.exr"), "wb") as f:  # a truncated frame
+            f.write(whole[:len(whole) // 2])
+        proc = self.run_sequence("--frames", "1-5")
+        self.assertEqual(proc.returncode, 1, proc.stderr)
+        self.assertIn("frame 3 (3/5): error: cannot read", proc.stderr)
+        self.assertIn("frame 5 (5/5): error: cannot read", proc.stderr)
+        self.assertIn("ssao: 3 of 5 frames written", proc.stderr)
+        self.assertIn("failed: 3,5", proc.stderr)
+        self.assertIn("frame 2 (2/5): " + self.path("out.0002.exr"), proc.stderr)
+        self.assertFalse(os.path.exists(self.path("out.0003.exr")))
+        self.assertFalse(os.path.exists(self.path("out.0005.exr")))
+        self.assertEqual([f for f in os.listdir(self.dir) if ".tmp" in f], [])
+        # Each frame equals the same frame run alone, bit for bit.
+        previous = None
+        for frame in (1, 2, 4):
+            single = self.path(f"single.{frame}.exr")
+            alone = self.run_ssao(self.path(f"in.{frame:04d}.exr"), "-o", single, "--camera",
+                                  self.camera, "--radius", str(RADIUS), "--threads", "1",
+                                  default_paths=False)
+            self.assertEqual(alone.returncode, 0, alone.stderr)
+            names, a = read_image(self.path(f"out.{frame:04d}.exr"))
+            _, b = read_image(single)
+            np.testing.assert_array_equal(a, b, err_msg=f"frame {frame}")
+            ao = a[:, :, names.index("AO")]
+            if previous is not None:
+                self.assertFalse(np.array_equal(ao, previous), "frames should differ")
+            previous = ao
+
+    def test_skip_existing_and_json_progress(self):
+        self.write_frames([1, 2, 3])
+        self.assertEqual(self.run_sequence("--frames", "1-3").returncode, 0)
+        os.remove(self.path("out.0002.exr"))
+        kept = os.stat(self.path("out.0001.exr")).st_mtime_ns
+        proc = self.run_sequence("--frames", "1-3", "--skip-existing", "--progress", "json")
+        self.assertEqual(proc.returncode, 0, proc.stderr)
+        lines = [json.loads(line) for line in proc.stderr.splitlines() if line.startswith("{")]
+        self.assertEqual([(r["frame"], r["status"]) for r in lines],
+                         [(1, "skipped"), (2, "ok"), (3, "skipped")])
+        self.assertEqual([r["index"] for r in lines], [1, 2, 3])
+        self.assertTrue(all(r["total"] == 3 for r in lines))
+        self.assertGreater(lines[1]["seconds"], 0.0)
+        self.assertIsNotNone(lines[1]["mean_ao"])
+        self.assertTrue(os.path.isfile(self.path("out.0002.exr")))
+        self.assertEqual(os.stat(self.path("out.0001.exr")).st_mtime_ns, kept)
+
+    def test_steps_lists_and_placeholders(self):
+        self.write_frames([1, 3, 5, 12], pattern="in.{:03d}.exr")
+        proc = self.run_sequence("--frames", "1-5x2,12", inp="in.%03d.exr", out="o.@@@@.png")
+        self.assertEqual(proc.returncode, 0, proc.stderr)
+        self.assertEqual(sorted(f for f in os.listdir(self.dir) if f.startswith("o.")),
+                         ["o.0001.png", "o.0003.png", "o.0005.png", "o.0012.png"])
+        self.assertIn("4 of 4 frames written", proc.stderr)
+        self.assertIn("frames per minute", proc.stderr)
+
+    def test_sequence_usage_errors(self):
+        self.write_frames([1])
+        cases = [
+            (("--frames", "5-1"), {}, "runs backwards"),
+            (("--frames", "1-2"), {"out": "out.exr"}, "-o needs a frame placeholder"),
+            (("--frames", "1"), {"inp": "in.0001.exr"}, "the input needs a frame placeholder"),
+            (("--frames", "1-3,2"), {}, "frame 2 is given twice"),
+            (("--frames", "1", "--progress", "xml"), {}, "text or json"),
+        ]
+        for args, paths, phrase in cases:
+            with self.subTest(phrase=phrase):
+                proc = self.run_sequence(*args, **paths)
+                self.assertEqual(proc.returncode, 2, proc.stderr)
+                self.assertIn(phrase, proc.stderr)
+        proc = self.run_ssao("--skip-existing")
+        self.assertEqual(proc.returncode, 2)
+        self.assertIn("apply to sequences", proc.stderr)
+        # Without --radius the frames need the camera file's ao_distance.
+        proc = self.run_ssao(self.path("in.####.exr"), "-o", self.path("o.####.exr"),
+                             "--camera", self.camera, "--frames", "1", default_paths=False)
+        self.assertEqual(proc.returncode, 2, proc.stderr)
+        self.assertIn("a sequence needs --radius", proc.stderr)
+        self.camera = self.write_camera(dict(CAMERA, ao_distance=RADIUS))
+        proc = self.run_ssao(self.path("in.####.exr"), "-o", self.path("o.####.exr"),
+                             "--camera", self.camera, "--frames", "1", default_paths=False)
+        self.assertEqual(proc.returncode, 0, proc.stderr)
+
+
 class HelpTest(CliTestCase):
 
     def test_help_lists_every_parameter(self):
