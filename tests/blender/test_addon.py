@@ -16,6 +16,7 @@ import os
 import re
 import shlex
 import shutil
+import signal
 import subprocess
 import sys
 import tempfile
@@ -64,16 +65,34 @@ class Blender:
             raise AssertionError(f"{' '.join(command)} failed ({result.returncode}):\n{output}")
         return output
 
-    def run_ui(self, blend, script, *args, env=None, timeout=400):
-        """Blender's UI under Xvfb (xvfb-run) on `blend`, driven by `script`."""
+    def run_ui(self, blend, script, *args, env=None, timeout=240):
+        """Blender's UI under Xvfb (xvfb-run) on `blend`, driven by `script`.
+
+        Blender 5.2's UI has hung here (every thread waiting on a futex, the driver's own timer
+        never firing again: twice in about ten runs of this test, on 2026-11-24; not diagnosed,
+        see the issue 11 closing note). A hung run is killed with its whole process group, so
+        that no Blender or Xvfb outlives it, and run once more; a second hang fails the test."""
         # -a alone starts every xvfb-run at display 99: two at once (ctest -j) can collide.
         display = 100 + os.getpid() % 800
         command = ["xvfb-run", "-a", "-n", str(display), "-s", "-screen 0 1280x720x24"] + \
             shlex.split(CONFIG["blender"]) + ["--factory-startup", "-noaudio",
                                               "--addons", self.module, blend,
                                               "--python", script, "--"] + list(args)
-        result = subprocess.run(command, env={**self.env, **(env or {})}, cwd=self.root,
-                                capture_output=True, text=True, timeout=timeout)
+        for attempt in (1, 2):
+            process = subprocess.Popen(command, env={**self.env, **(env or {})}, cwd=self.root,
+                                       stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                                       start_new_session=True)
+            try:
+                stdout, stderr = process.communicate(timeout=timeout)
+                break
+            except subprocess.TimeoutExpired:
+                os.killpg(process.pid, signal.SIGKILL)
+                stdout, stderr = process.communicate()
+                print(f"\n[warning] the Blender UI run hung for {timeout} s (attempt {attempt}); "
+                      f"its last output:\n{(stdout + stderr)[-1500:]}", file=sys.stderr)
+                if attempt == 2:
+                    raise AssertionError(f"{' '.join(command)} hung twice")
+        result = subprocess.CompletedProcess(command, process.returncode, stdout, stderr)
         output = result.stdout + result.stderr
         with open(os.path.splitext(blend)[0] + ".ui.log", "w") as f:  # kept: SSAO_KEEP_SCRATCH
             f.write(output)
