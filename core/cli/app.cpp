@@ -427,6 +427,14 @@ void run_sequence(const Options& options) {
 
 }  // namespace
 
+void list_chunks(const Options& options) {
+  const size_t count = ssao_io::chunk_count(options.frames.size(), options.chunk_size);
+  for (size_t index = 0; index < count; ++index) {
+    const std::vector<int> chunk = ssao_io::chunk_frames(options.frames, options.chunk_size, index);
+    std::printf("%zu %s\n", index, ssao_io::format_frames(chunk).c_str());
+  }
+}
+
 void run_ssao(const Options& options) {
   if (!options.frames.empty()) {
     run_sequence(options);

@@ -22,4 +22,7 @@ class SequenceFailed : public ssao_io::Error {
 // reports the frames that failed after the others were written.
 void run_ssao(const Options& options);
 
+// --list-chunks: prints "INDEX FRAMES" for each chunk of --frames, one per line, on stdout.
+void list_chunks(const Options& options);
+
 }  // namespace ssao_cli

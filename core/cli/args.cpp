@@ -62,6 +62,26 @@ const std::vector<FrontOption>& front_options() {
        "with --frames: leave frames whose output exists (outputs are written atomically, so a "
        "killed run leaves no half frame)",
        [](Options& o, const std::string&, const std::string&) { o.skip_existing = true; }},
+      {kInputOutput, "--chunk-size", nullptr, "N",
+       "with --frames, for farms: cut the frame list, in order, into chunks of N frames (the "
+       "last one may be shorter); see --chunk-index, --list-chunks and docs/farm.md",
+       [](Options& o, const std::string& f, const std::string& v) {
+         const int size = ssao_io::parse_int(f, v);
+         if (size < 1) throw UsageError(f + " must be at least 1, got " + v);
+         o.chunk_size = size_t(size);
+       }},
+      {kInputOutput, "--chunk-index", nullptr, "I",
+       "with --chunk-size: process only chunk I (0 is the first), e.g. $SLURM_ARRAY_TASK_ID",
+       [](Options& o, const std::string& f, const std::string& v) {
+         const int index = ssao_io::parse_int(f, v);
+         if (index < 0) throw UsageError(f + " must be 0 or more, got " + v);
+         o.chunk_index = index;
+       }},
+      {kInputOutput, "--list-chunks", nullptr, nullptr,
+       "with --chunk-size: print one line per chunk, 'INDEX FRAMES' (FRAMES as --frames reads "
+       "them), and exit; IN.exr, -o and --camera may be left out (if IN.exr is given, the whole "
+       "command line is checked)",
+       [](Options& o, const std::string&, const std::string&) { o.list_chunks = true; }},
       {kOther, "--progress", nullptr, "text|json",
        "with --frames: a line per frame on stderr, as text (default) or one JSON object per line",
        [](Options& o, const std::string& f, const std::string& v) {
@@ -102,7 +122,32 @@ const std::vector<FrontOption>& front_options() {
   return options;
 }
 
+// --chunk-size / --chunk-index / --list-chunks: checked, and --frames narrowed to the chunk.
+void apply_chunking(Options& options) {
+  if (options.chunk_size == 0) {
+    if (options.chunk_index >= 0 || options.list_chunks) {
+      throw UsageError("--chunk-index and --list-chunks need --chunk-size N");
+    }
+    return;
+  }
+  if (options.frames.empty()) throw UsageError("--chunk-size applies to sequences (--frames)");
+  if (options.list_chunks && options.chunk_index >= 0) {
+    throw UsageError("--list-chunks lists every chunk: leave out --chunk-index");
+  }
+  if (options.chunk_index >= 0) {
+    try {
+      options.frames =
+          ssao_io::chunk_frames(options.frames, options.chunk_size, size_t(options.chunk_index));
+    } catch (const ssao_io::Error& e) {
+      throw UsageError(std::string("--chunk-index: ") + e.what() + " (--frames " +
+                       options.frames_text + ")");
+    }
+  }
+}
+
 void require_complete(const Options& options) {
+  // --list-chunks needs only --frames and --chunk-size; a full command line is checked whole.
+  if (options.list_chunks && options.input.empty()) return;
   if (options.input.empty()) throw UsageError("missing the input file IN.exr");
   if (options.output.empty()) throw UsageError("missing the output file: -o OUT.exr");
   if (options.camera.empty()) throw UsageError("missing the camera description: --camera CAM.json");
@@ -139,6 +184,7 @@ Options parse_args(int argc, const char* const* argv, const std::vector<ssao_par
 
     ssao_io::parse_option(argc, argv, i, front_options(), table, out);
   }
+  apply_chunking(out);
   require_complete(out);
   return out;
 }

@@ -37,6 +37,10 @@ struct Options {
   std::string frames_text;
   bool skip_existing = false;
   bool json_progress = false;
+  // Farm chunks: with chunk_index >= 0, `frames` holds only that chunk once parsed.
+  size_t chunk_size = 0;  // 0: no chunking
+  int chunk_index = -1;
+  bool list_chunks = false;
 };
 
 // Parses argv. With --help or --version anywhere, only that flag is honoured. Throws UsageError

@@ -20,6 +20,10 @@ int main(int argc, char** argv) {
       std::printf("ssao %s\n", ssao_io::version_string(ssao_version()).c_str());
       return 0;
     }
+    if (options.list_chunks) {
+      ssao_cli::list_chunks(options);
+      return 0;
+    }
     ssao_cli::run_ssao(options);
     return 0;
   } catch (const ssao_cli::UsageError& e) {

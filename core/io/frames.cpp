@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: MIT
 #include "io/frames.h"
 
+#include <algorithm>
 #include <cctype>
 #include <cerrno>
 #include <climits>
@@ -70,6 +71,47 @@ std::vector<int> parse_frames(const std::string& spec) {
     begin = comma + 1;
   }
   return frames;
+}
+
+std::string format_frames(const std::vector<int>& frames) {
+  std::string spec;
+  for (size_t i = 0; i < frames.size();) {
+    // The longest run from frames[i] with one positive step; three frames at least, so that a
+    // pair of unrelated frames is not written as a range (a step-1 pair is: "7-8").
+    size_t end = i + 1;
+    const long long step = end < frames.size() ? (long long)frames[end] - frames[i] : 0;
+    if (step > 0) {
+      while (end < frames.size() && (long long)frames[end] - frames[end - 1] == step) ++end;
+    }
+    const size_t length = end - i;
+    if (!spec.empty()) spec += ',';
+    if (step > 0 && (length >= 3 || (length == 2 && step == 1))) {
+      spec += std::to_string(frames[i]) + "-" + std::to_string(frames[end - 1]);
+      if (step > 1) spec += "x" + std::to_string(step);
+      i = end;
+    } else {
+      spec += std::to_string(frames[i]);
+      ++i;
+    }
+  }
+  return spec;
+}
+
+size_t chunk_count(size_t frame_count, size_t chunk_size) {
+  return chunk_size == 0 ? 0 : (frame_count + chunk_size - 1) / chunk_size;
+}
+
+std::vector<int> chunk_frames(const std::vector<int>& frames, size_t chunk_size, size_t index) {
+  const size_t count = chunk_count(frames.size(), chunk_size);
+  if (index >= count) {
+    throw Error("chunk " + std::to_string(index) +
+                " does not exist: " + std::to_string(frames.size()) + " frames in chunks of " +
+                std::to_string(chunk_size) + " make " + std::to_string(count) + " chunks (0-" +
+                std::to_string(count == 0 ? 0 : count - 1) + ")");
+  }
+  const size_t first = index * chunk_size;
+  const size_t last = std::min(frames.size(), first + chunk_size);
+  return std::vector<int>(frames.begin() + long(first), frames.begin() + long(last));
 }
 
 FramePattern::FramePattern(const std::string& text) : text_(text) {

@@ -22,6 +22,17 @@ constexpr size_t kMaxFrames = 1000000;
 // of int range, more than kMaxFrames frames, or a frame given twice.
 std::vector<int> parse_frames(const std::string& spec);
 
+// A specification that parse_frames reads back as `frames`: runs with one step are written
+// "A-B" or "A-BxN", other frames one by one ("1001-1010,1013,1020-1040x10").
+std::string format_frames(const std::vector<int>& frames);
+
+// Farm chunks: `frames`, in the order given, cut into chunks of `chunk_size` frames (the last one
+// shorter when the count is not a multiple). Chunks are numbered from 0, so a job array's task
+// index picks its chunk from the whole frame list, and no task needs the range's last index.
+size_t chunk_count(size_t frame_count, size_t chunk_size);
+// Throws Error when `index` is not below chunk_count().
+std::vector<int> chunk_frames(const std::vector<int>& frames, size_t chunk_size, size_t index);
+
 // A file name with at most one frame placeholder.
 class FramePattern {
  public:

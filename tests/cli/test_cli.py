@@ -447,6 +447,32 @@ class SequenceTest(CliTestCase):
         self.assertIn("4 of 4 frames written", proc.stderr)
         self.assertIn("frames per minute", proc.stderr)
 
+    def test_chunks_split_the_frames_for_farms(self):
+        # 5 frames in chunks of 2: the last chunk holds one frame.
+        proc = self.run_ssao("--frames", "1-3,7,9", "--chunk-size", "2", "--list-chunks",
+                             default_paths=False)
+        self.assertEqual(proc.returncode, 0, proc.stderr)
+        self.assertEqual(proc.stdout, "0 1-2\n1 3,7\n2 9\n")
+        self.write_frames([1, 2, 3])
+        proc = self.run_sequence("--frames", "1-3", "--chunk-size", "2", "--chunk-index", "1")
+        self.assertEqual(proc.returncode, 0, proc.stderr)
+        self.assertEqual(sorted(f for f in os.listdir(self.dir) if f.startswith("out.")),
+                         ["out.0003.exr"])
+        self.assertIn("1 of 1 frames written", proc.stderr)
+        cases = [
+            (("--frames", "1-3", "--chunk-size", "2", "--chunk-index", "2"),
+             "chunk 2 does not exist: 3 frames in chunks of 2 make 2 chunks (0-1)"),
+            (("--chunk-size", "2"), "--chunk-size applies to sequences"),
+            (("--frames", "1-3", "--chunk-index", "0"), "need --chunk-size"),
+            (("--frames", "1-3", "--chunk-size", "0"), "at least 1"),
+            (("--frames", "1-3", "--chunk-size", "2", "--chunk-index", "-1"), "0 or more"),
+        ]
+        for args, phrase in cases:
+            with self.subTest(phrase=phrase):
+                proc = self.run_sequence(*args)
+                self.assertEqual(proc.returncode, 2, proc.stderr)
+                self.assertIn(phrase, proc.stderr)
+
     def test_sequence_usage_errors(self):
         self.write_frames([1])
         cases = [

@@ -69,3 +69,65 @@ TEST(Frames, PatternsPadTheFrameNumber) {
   EXPECT_THROW(FramePattern("a.##.b.##.exr"), ssao_io::Error);
   EXPECT_THROW(FramePattern("a.%04d.#.exr"), ssao_io::Error);
 }
+
+TEST(Frames, FormatIsReadBackAsTheSameFrames) {
+  using ssao_io::format_frames;
+  EXPECT_EQ(format_frames({1001, 1002, 1003}), "1001-1003");
+  EXPECT_EQ(format_frames({1, 5, 9, 10, 11, 12}), "1-9x4,10-12");
+  EXPECT_EQ(format_frames({7, 8}), "7-8");
+  EXPECT_EQ(format_frames({7, 9}), "7,9");
+  EXPECT_EQ(format_frames({-5, -4, -3, 10}), "-5--3,10");
+  EXPECT_EQ(format_frames({3}), "3");
+  // Random lists (a fixed seed, so a failure repeats): unordered, gaps, runs, negatives.
+  unsigned state = 12345u;
+  auto next = [&state](int n) {
+    state = state * 1103515245u + 12345u;
+    return int((state >> 16) % unsigned(n));
+  };
+  for (int trial = 0; trial < 500; ++trial) {
+    std::vector<int> frames;
+    std::vector<bool> used(400, false);
+    const int count = 1 + next(40);
+    for (int k = 0; k < count; ++k) {
+      int frame = next(400);
+      const int run = next(3) == 0 ? next(6) : 0;  // sometimes a run of consecutive frames
+      for (int r = 0; r <= run && frame < 400; ++r, ++frame) {
+        if (!used[size_t(frame)]) {
+          used[size_t(frame)] = true;
+          frames.push_back(frame - 200);
+        }
+      }
+    }
+    const std::string spec = format_frames(frames);
+    EXPECT_EQ(parse_frames(spec), frames) << spec;
+  }
+}
+
+TEST(Frames, ChunksCoverEveryFrameOnceInOrder) {
+  using ssao_io::chunk_count;
+  using ssao_io::chunk_frames;
+  // 11 frames in chunks of 4: the last chunk is short (the Slurm trap: an array 1001-1011:4
+  // reports 1009 as its last index, and frames 1010-1011 must not be lost).
+  const std::vector<int> frames = parse_frames("1001-1011");
+  ASSERT_EQ(chunk_count(frames.size(), 4), 3u);
+  EXPECT_EQ(chunk_frames(frames, 4, 0), parse_frames("1001-1004"));
+  EXPECT_EQ(chunk_frames(frames, 4, 1), parse_frames("1005-1008"));
+  EXPECT_EQ(chunk_frames(frames, 4, 2), parse_frames("1009-1011"));
+  for (size_t size : {1u, 2u, 3u, 5u, 10u, 11u, 100u}) {
+    std::vector<int> joined;
+    for (size_t i = 0; i < chunk_count(frames.size(), size); ++i) {
+      const std::vector<int> chunk = chunk_frames(frames, size, i);
+      EXPECT_LE(chunk.size(), size);
+      EXPECT_FALSE(chunk.empty());
+      joined.insert(joined.end(), chunk.begin(), chunk.end());
+    }
+    EXPECT_EQ(joined, frames) << "chunks of " << size;
+  }
+  EXPECT_EQ(chunk_count(0, 4), 0u);
+  try {
+    chunk_frames(frames, 4, 3);
+    FAIL() << "chunk 3 of 3 was accepted";
+  } catch (const ssao_io::Error& e) {
+    EXPECT_NE(std::string(e.what()).find("make 3 chunks (0-2)"), std::string::npos) << e.what();
+  }
+}
