@@ -15,6 +15,7 @@
 #include <string>
 #include <vector>
 
+#include "animation.h"
 #include "io/image_io.h"
 #include "io/job.h"
 #include "io/param_flags.h"
@@ -351,17 +352,27 @@ struct Povray {
   std::vector<std::string> user_options;  // --ini and the pass-through options, in order
   const ScratchFolder* scratch = nullptr;
   bool keep = false;
+  const AnimationFrame* frame = nullptr;  // an animation's frame: rendered alone (+SF +EF)
 
-  // Starts rendering `wrapper` to <name>.exr; finish() waits for it.
+  // Where POV-Ray writes +O<name>.exr: an animation frame's number goes before the extension.
+  std::string output(const std::string& name) const {
+    return scratch->file(name + (frame ? frame->digits : "") + ".exr");
+  }
+
+  // Starts rendering `wrapper` to output(name); finish() waits for it.
   Render start(const std::string& what, const std::string& name, const std::string& wrapper,
                int width, int height, const std::vector<std::string>& extra) const {
     Render render;
     render.what = what;
-    render.output = scratch->file(name + ".exr");
+    render.output = output(name);
     render.log = scratch->file(name + ".log");
     std::vector<std::string> args = user_options;
+    if (frame) {
+      args.push_back("+SF" + std::to_string(frame->number));
+      args.push_back("+EF" + std::to_string(frame->number));
+    }
     args.push_back("+I" + scratch->file(wrapper));
-    args.push_back("+O" + render.output);
+    args.push_back("+O" + scratch->file(name + ".exr"));
     args.push_back("+W" + std::to_string(width));
     args.push_back("+H" + std::to_string(height));
     args.push_back("-D");
@@ -457,97 +468,37 @@ void print_camera(const CameraReading& reading, int width, int height) {
               job.get_float("pixel_aspect_y"));
 }
 
-}  // namespace
+// What every image of a render shares: the scene, the size, the scan settings, the clock.
+struct RenderSetup {
+  fs::path scene_path;
+  std::string scene_folder, scene_name, includes;
+  int width = 0, height = 0;
+  ScanSettings settings;
+  ClockOptions clock;
+};
 
-void run_render(const Options& o) {
-  InterruptGuard interrupt_guard;
-  const Reporter report(o.quiet);
+// One image (a still, or one frame of an animation): the passes, AO and the outputs.
+void render_image(const Options& o, const RenderSetup& setup, const AnimationFrame* frame,
+                  const Reporter& report) {
   const auto start = Clock::now();
-
-  // Everything that can be checked before POV-Ray runs.
+  const std::string& scene_folder = setup.scene_folder;
+  const std::string& scene_name = setup.scene_name;
+  const std::string& includes = setup.includes;
+  const int width = setup.width, height = setup.height;
   std::error_code ec;
-  if (!fs::exists(o.scene, ec)) throw ssao_io::Error("no scene file " + in_quotes(o.scene));
-  if (!fs::is_regular_file(o.scene, ec)) {
-    throw ssao_io::Error("the scene " + in_quotes(o.scene) + " is not a file");
-  }
-  if (::access(o.scene.c_str(), R_OK) != 0) {
-    throw ssao_io::Error("cannot read the scene file " + in_quotes(o.scene));
-  }
-  const fs::path scene_path = fs::absolute(o.scene).lexically_normal();
-  const std::string scene_folder = scene_path.parent_path().string();
-  const std::string scene_name = scene_path.filename().string();
-  if (scene_name.find('"') != std::string::npos) {
-    throw ssao_io::Error(
-        "the scene's file name contains '\"', which POV-Ray's #include cannot "
-        "take");
-  }
-  if (!o.print_camera) {
-    check_output_folder(o.output);
-    if (!o.exr.empty()) check_output_folder(o.exr);
-    if (same_file(o.output, o.scene) || (!o.exr.empty() && same_file(o.exr, o.scene))) {
-      throw UsageError("the output is the scene file; choose another -o");
-    }
-  }
-  if (!o.ini.empty() && !fs::is_regular_file(o.ini, ec)) {
-    throw ssao_io::Error("no INI file " + in_quotes(o.ini));
-  }
   if (!o.keep.empty()) {
     fs::create_directories(o.keep, ec);
     if (!fs::is_directory(o.keep, ec)) {
       throw ssao_io::Error("--keep: cannot create the folder " + in_quotes(o.keep));
     }
   }
+  ScanSettings settings = setup.settings;
+  if (frame) {
+    settings.clock = frame->clock;
+    declare_frame(setup.clock, *frame, settings.predeclared);
+  }
+  const SceneScan scan = scan_scene(setup.scene_path.string(), settings);
 
-  int width = o.width, height = o.height;
-  if (!o.ini.empty() && (width == 0 || height == 0)) {
-    int w = 0, h = 0;
-    ini_size(o.ini, w, h);
-    if (width == 0) width = w;
-    if (height == 0) height = h;
-  }
-  default_size(scene_folder, width, height);
-
-  // The camera, from the scene text (and its include files, found as POV-Ray finds them).
-  const std::string includes = include_folder();
-  std::vector<std::string> library_paths;
-  const std::string startup_ini = system_ini(scene_folder);
-  if (!startup_ini.empty()) ini_library_paths(startup_ini, library_paths);
-  if (!o.ini.empty()) ini_library_paths(o.ini, library_paths);
-  for (const std::string& option : o.povray_options) {
-    if (option.size() > 2 && (option[1] == 'L' || option[1] == 'l')) {
-      library_paths.push_back(option.substr(2));
-    } else if (option.size() > 13 &&
-               (option.rfind("Library_Path=", 0) == 0 || option.rfind("library_path=", 0) == 0)) {
-      library_paths.push_back(option.substr(13));
-    }
-  }
-  library_paths.push_back(scene_folder);
-  library_paths.push_back(includes);
-  for (std::string& path : library_paths) {
-    if (fs::path(path).is_relative()) path = (fs::path(scene_folder) / path).string();
-  }
-  ScanSettings settings;
-  settings.directory = scene_folder;
-  settings.library_paths = library_paths;
-  settings.image_width = width;
-  settings.image_height = height;
-  std::vector<std::string> declares;
-  if (!startup_ini.empty()) ini_declares(startup_ini, declares, settings.clock);
-  if (!o.ini.empty()) ini_declares(o.ini, declares, settings.clock);
-  option_declares(o.povray_options, declares, settings.clock);
-  for (const std::string& declare : declares) {
-    // NAME=VALUE with a number (POV-Ray's Declare= takes floats only).
-    const size_t equals = declare.find('=');
-    Symbol symbol;
-    symbol.kind = Symbol::kValue;
-    symbol.declared_at = "Declare=" + declare;
-    char* end = nullptr;
-    symbol.value.v.x = std::strtod(declare.c_str() + equals + 1, &end);
-    if (equals != std::string::npos && end && *end == '\0') {
-      settings.predeclared[declare.substr(0, equals)] = symbol;
-    }
-  }
-  const SceneScan scan = scan_scene(scene_path.string(), settings);
   const CameraReading reading = read_camera(scan, o.camera, width, height);
   if (o.print_camera) {
     for (const std::string& note : scan.notes) report.warning(note);
@@ -581,6 +532,7 @@ void run_render(const Options& o) {
                              o.povray_options.end());
   ScratchFolder scratch;
   povray.scratch = &scratch;
+  povray.frame = frame;
   povray.keep = !o.keep.empty();
   KeepFiles keep(scratch, o.keep, report);
   write_wrappers(scratch.path(), scene_name, reading.camera);
@@ -658,9 +610,9 @@ void run_render(const Options& o) {
     for (const std::string& d : fog_declares(prepass_distances())) extra.push_back(d);
     if (scan.uses_radiosity) extra.push_back("Declare=SSAODepthCheapRadiosity=1");
     prepass_seconds = povray.render("depth-range pre-pass", "prepass", "depth.pov", pw, ph, extra);
-    const ssao_io::Image image = ssao_io::read_image(scratch.file("prepass.exr"));
+    const ssao_io::Image image = ssao_io::read_image(povray.output("prepass"));
     const DepthStats stats =
-        depth_stats(decode_fog(image, prepass_distances(), scratch.file("prepass.exr")));
+        depth_stats(decode_fog(image, prepass_distances(), povray.output("prepass")));
     distances = choose_distances(stats);
     if (stats.geometry == 0) {
       report.end("%.2f s", prepass_seconds);
@@ -856,6 +808,167 @@ void run_render(const Options& o) {
   }
   report.progress("wrote %s in %.2f s (passes at once: %s; AO %.2f s)", written.c_str(),
                   seconds_since(start), passes.c_str(), ao_seconds);
+}
+
+// Every frame of an animation, each on its own: a frame that fails is reported and the others
+// are still rendered; the failures are listed at the end.
+void render_animation(const Options& o, const RenderSetup& setup,
+                      const std::vector<AnimationFrame>& frames, const Reporter& report) {
+  const auto start = Clock::now();
+  std::vector<long> failed;
+  size_t written = 0;
+  double seconds_done = 0.0;
+  for (size_t i = 0; i < frames.size(); ++i) {
+    const AnimationFrame& frame = frames[i];
+    Options frame_options = o;
+    if (!o.print_camera) frame_options.output = frame_output(o.output, frame);
+    if (!o.exr.empty()) frame_options.exr = frame_output(o.exr, frame);
+    if (!o.keep.empty())
+      frame_options.keep = (fs::path(o.keep) / ("frame" + frame.digits)).string();
+    report.progress("frame %ld (%zu/%zu), clock %.6g:", frame.number, i + 1, frames.size(),
+                    frame.clock);
+    const auto frame_start = Clock::now();
+    try {
+      render_image(frame_options, setup, &frame, report);
+      ++written;
+    } catch (const UsageError&) {
+      throw;  // a command-line mistake is every frame's
+    } catch (const ssao_io::Error& e) {
+      if (InterruptGuard::interrupted()) throw;
+      std::fprintf(stderr, "povray-ssao: frame %ld: error: %s\n", frame.number, e.what());
+      std::fflush(stderr);
+      failed.push_back(frame.number);
+    }
+    seconds_done += seconds_since(frame_start);
+    const double left = seconds_done / double(i + 1) * double(frames.size() - i - 1);
+    if (i + 1 < frames.size()) {
+      report.progress("frame %ld done (%zu/%zu) in %.2f s; about %.0f s left", frame.number, i + 1,
+                      frames.size(), seconds_since(frame_start), left);
+    }
+  }
+  if (o.print_camera) return;
+  const double wall = seconds_since(start);
+  std::string list;
+  for (size_t k = 0; k < failed.size() && k < 50; ++k) {
+    list += (k ? "," : "") + std::to_string(failed[k]);
+  }
+  if (failed.size() > 50) list += ",...";
+  report.progress("%zu of %zu frames written in %.1f s (%.1f frames per minute)", written,
+                  frames.size(), wall, wall > 0.0 ? 60.0 * double(written) / wall : 0.0);
+  if (!failed.empty()) {
+    throw ssao_io::Error(std::to_string(failed.size()) + " of " + std::to_string(frames.size()) +
+                         " frames failed: " + list);
+  }
+}
+}  // namespace
+
+void run_render(const Options& o) {
+  InterruptGuard interrupt_guard;
+  const Reporter report(o.quiet);
+
+  // Everything that can be checked before POV-Ray runs.
+  std::error_code ec;
+  if (!fs::exists(o.scene, ec)) throw ssao_io::Error("no scene file " + in_quotes(o.scene));
+  if (!fs::is_regular_file(o.scene, ec)) {
+    throw ssao_io::Error("the scene " + in_quotes(o.scene) + " is not a file");
+  }
+  if (::access(o.scene.c_str(), R_OK) != 0) {
+    throw ssao_io::Error("cannot read the scene file " + in_quotes(o.scene));
+  }
+  const fs::path scene_path = fs::absolute(o.scene).lexically_normal();
+  const std::string scene_folder = scene_path.parent_path().string();
+  const std::string scene_name = scene_path.filename().string();
+  if (scene_name.find('"') != std::string::npos) {
+    throw ssao_io::Error(
+        "the scene's file name contains '\"', which POV-Ray's #include cannot "
+        "take");
+  }
+  if (!o.print_camera) {
+    check_output_folder(o.output);
+    if (!o.exr.empty()) check_output_folder(o.exr);
+    if (same_file(o.output, o.scene) || (!o.exr.empty() && same_file(o.exr, o.scene))) {
+      throw UsageError("the output is the scene file; choose another -o");
+    }
+  }
+  if (!o.ini.empty() && !fs::is_regular_file(o.ini, ec)) {
+    throw ssao_io::Error("no INI file " + in_quotes(o.ini));
+  }
+  if (!o.keep.empty()) {
+    fs::create_directories(o.keep, ec);
+    if (!fs::is_directory(o.keep, ec)) {
+      throw ssao_io::Error("--keep: cannot create the folder " + in_quotes(o.keep));
+    }
+  }
+
+  int width = o.width, height = o.height;
+  if (!o.ini.empty() && (width == 0 || height == 0)) {
+    int w = 0, h = 0;
+    ini_size(o.ini, w, h);
+    if (width == 0) width = w;
+    if (height == 0) height = h;
+  }
+  default_size(scene_folder, width, height);
+
+  // The camera, from the scene text (and its include files, found as POV-Ray finds them).
+  const std::string includes = include_folder();
+  std::vector<std::string> library_paths;
+  const std::string startup_ini = system_ini(scene_folder);
+  if (!startup_ini.empty()) ini_library_paths(startup_ini, library_paths);
+  if (!o.ini.empty()) ini_library_paths(o.ini, library_paths);
+  for (const std::string& option : o.povray_options) {
+    if (option.size() > 2 && (option[1] == 'L' || option[1] == 'l')) {
+      library_paths.push_back(option.substr(2));
+    } else if (option.size() > 13 &&
+               (option.rfind("Library_Path=", 0) == 0 || option.rfind("library_path=", 0) == 0)) {
+      library_paths.push_back(option.substr(13));
+    }
+  }
+  library_paths.push_back(scene_folder);
+  library_paths.push_back(includes);
+  for (std::string& path : library_paths) {
+    if (fs::path(path).is_relative()) path = (fs::path(scene_folder) / path).string();
+  }
+  RenderSetup setup;
+  ScanSettings settings;
+  settings.directory = scene_folder;
+  settings.library_paths = library_paths;
+  settings.image_width = width;
+  settings.image_height = height;
+  std::vector<std::string> declares;
+  if (!startup_ini.empty()) ini_declares(startup_ini, declares, setup.clock);
+  if (!o.ini.empty()) ini_declares(o.ini, declares, setup.clock);
+  option_declares(o.povray_options, declares, setup.clock);
+  settings.clock = setup.clock.clock;
+  for (const std::string& declare : declares) {
+    // NAME=VALUE with a number (POV-Ray's Declare= takes floats only).
+    const size_t equals = declare.find('=');
+    Symbol symbol;
+    symbol.kind = Symbol::kValue;
+    symbol.declared_at = "Declare=" + declare;
+    char* end = nullptr;
+    symbol.value.v.x = std::strtod(declare.c_str() + equals + 1, &end);
+    if (equals != std::string::npos && end && *end == '\0') {
+      settings.predeclared[declare.substr(0, equals)] = symbol;
+    }
+  }
+  setup.settings = settings;
+  setup.scene_path = scene_path;
+  setup.scene_folder = scene_folder;
+  setup.scene_name = scene_name;
+  setup.includes = includes;
+  setup.width = width;
+  setup.height = height;
+  const std::vector<AnimationFrame> frames = animation_frames(setup.clock);
+  if (!frames.empty() && !o.param("radius") && !o.depth_only && !o.print_camera) {
+    throw UsageError(
+        "an animation needs --radius R (scene units), so that its frames share one radius: the "
+        "automatic radius follows each frame's depth (a still prints the radius it chooses)");
+  }
+  if (frames.empty()) {
+    render_image(o, setup, nullptr, report);
+    return;
+  }
+  render_animation(o, setup, frames, report);
 }
 
 void run_post_process(const Options& o) {

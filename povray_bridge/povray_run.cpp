@@ -307,27 +307,21 @@ void ini_library_paths(const std::string& path, std::vector<std::string>& paths)
 
 namespace {
 
-// One INI line or command-line option: Declare=NAME=VALUE, Clock=V or +KV.
-void declare_option(const std::string& text, std::vector<std::string>& declares, double& clock) {
+// One INI line or command-line option: Declare=NAME=VALUE, or a clock or animation option.
+void declare_option(const std::string& text, std::vector<std::string>& declares,
+                    ClockOptions& clock) {
+  if (read_clock_option(text, clock)) return;
   const std::string option = trim(text);
-  if ((option[0] == '+' || option[0] == '-') && option.size() > 2 &&
-      std::toupper(static_cast<unsigned char>(option[1])) == 'K' &&
-      (std::isdigit(static_cast<unsigned char>(option[2])) || option[2] == '.' ||
-       option[2] == '-')) {
-    clock = std::strtod(option.c_str() + 2, nullptr);
-    return;
-  }
   const size_t equals = option.find('=');
   if (equals == std::string::npos) return;
   const std::string key = lower(trim(option.substr(0, equals)));
-  const std::string value = trim(option.substr(equals + 1));
-  if (key == "declare") declares.push_back(value);
-  if (key == "clock") clock = std::strtod(value.c_str(), nullptr);
+  if (key == "declare") declares.push_back(trim(option.substr(equals + 1)));
 }
 
 }  // namespace
 
-void ini_declares(const std::string& path, std::vector<std::string>& declares, double& clock) {
+void ini_declares(const std::string& path, std::vector<std::string>& declares,
+                  ClockOptions& clock) {
   for (const std::string& line : ini_lines(path, false)) {
     if (line[0] == '+' || line[0] == '-') {
       std::stringstream words(line);
@@ -340,7 +334,7 @@ void ini_declares(const std::string& path, std::vector<std::string>& declares, d
 }
 
 void option_declares(const std::vector<std::string>& options, std::vector<std::string>& declares,
-                     double& clock) {
+                     ClockOptions& clock) {
   for (const std::string& option : options) declare_option(option, declares, clock);
 }
 

@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "animation.h"
 #include "io/error.h"
 
 namespace povray_ssao {
@@ -70,11 +71,12 @@ void ini_size(const std::string& path, int& width, int& height);
 // The library paths an INI file adds (Library_Path=..., +L...), appended to `paths`.
 void ini_library_paths(const std::string& path, std::vector<std::string>& paths);
 
-// The Declare=NAME=VALUE settings (appended to `declares` as NAME=VALUE) and the clock
-// (Clock=, +K) of an INI file or of a list of command-line options.
-void ini_declares(const std::string& path, std::vector<std::string>& declares, double& clock);
+// The Declare=NAME=VALUE settings (appended to `declares` as NAME=VALUE), the clock and the
+// animation options (Clock=, +K, +KFI, ...: animation.h) of an INI file or of a list of
+// command-line options.
+void ini_declares(const std::string& path, std::vector<std::string>& declares, ClockOptions& clock);
 void option_declares(const std::vector<std::string>& options, std::vector<std::string>& declares,
-                     double& clock);
+                     ClockOptions& clock);
 
 // The INI file POV-Ray reads at start-up: $POVINI, ./povray.ini in `working_directory`,
 // ~/.povray/3.7/povray.ini or /etc/povray/3.7/povray.ini, the first that exists; "" if none.

@@ -481,10 +481,6 @@ class Parser {
     if (name == "true" || name == "yes" || name == "on") return number(1.0);
     if (name == "false" || name == "no" || name == "off") return number(0.0);
     if (name == "clock") return number(context_.clock);
-    if (name == "clock_on") return number(0.0);
-    if (name == "frame_number" || name == "initial_frame" || name == "final_frame") {
-      return number(0.0);
-    }
     if (name == "image_width" || name == "image_height") {
       if (context_.image_width <= 0) fail(token, name + " is unknown here");
       return number(name == "image_width" ? context_.image_width : context_.image_height);
@@ -500,6 +496,12 @@ class Parser {
                  (symbol.kind == Symbol::kCamera ? std::string("a camera") : symbol.description) +
                  ", not a number or vector povray-ssao can evaluate");
       }
+    }
+    // The animation identifiers of a still (an animation frame's are predeclared symbols).
+    if (name == "clock_on" || name == "frame_number" || name == "initial_frame" ||
+        name == "final_frame" || name == "initial_clock" || name == "final_clock" ||
+        name == "clock_delta") {
+      return number(0.0);
     }
     if (camera_keywords().count(name)) fail(token, "expected a value, found '" + name + "'");
     fail(token, "'" + name +

@@ -176,7 +176,8 @@ struct ScanSettings {
   std::vector<std::string> library_paths;  // +L and Library_Path folders, in order
   int image_width = 0, image_height = 0;
   double clock = 0.0;
-  Symbols predeclared;  // Declare=NAME=VALUE of the command line and INI files
+  Symbols predeclared;  // Declare=NAME=VALUE of the command line and INI files, and an
+                        // animation frame's frame_number, clock_on, ... (animation.h)
 };
 
 // Reads `path` and follows its #include files as POV-Ray finds them: in the scene's folder, then

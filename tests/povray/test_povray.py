@@ -768,6 +768,90 @@ class NormalPassTest(PovTestCase):
 
 # ----------------------------------------------------------------------------------------------
 
+class AnimationTest(PovTestCase):
+    """+KFI/+KFF: every frame rendered at its own clock, its own camera and depth pass, named
+    as POV-Ray names its frames."""
+
+    # The camera moves towards a wall (z = 0) along the view axis: clock c puts it 6 - 2c away.
+    # frame_number is read by the scene too (the failure case), as POV-Ray gives it.
+    SCENE = """#version 3.7;
+global_settings { assumed_gamma 1.0 }
+#ifndef (Fail) #declare Fail = 0; #end
+#if (Fail & frame_number = 2) #error "frame 2 is broken on purpose" #end
+camera { location <0, 1, -6 + 2 * clock> look_at <0, 1, 0> angle 60 }
+light_source { <3, 6, -8> rgb 1 }
+plane { -z, 0 pigment { rgb 0.8 } }  // the normal faces the camera: it must not be inside
+plane { y, 0 pigment { rgb 0.6 } }
+box { <0.6, 0, -1.5>, <1.6, 1, -0.5> pigment { rgb <0.9, 0.4, 0.3> } }  // off the view axis
+"""
+    SIZE = ("+W64", "+H48")
+
+    def wall_distance(self, exr):
+        """The Z (planar depth) at the image centre, where the view axis meets the wall."""
+        names, pixels = read_image(exr)
+        z = channel(names, pixels, "Z")
+        return float(z[23:25, 31:33].mean())
+
+    def test_each_frame_has_its_own_clock_and_camera(self):
+        scene = self.copy_scene("moving.pov", self.SCENE)
+        proc = self.run_bridge(scene, *self.SIZE, "+KFI1", "+KFF3", "--radius", "0.5", "-o",
+                               self.path("out.png"), "--exr", self.path("out.exr"))
+        outputs = [self.path(f"out{n}.{ext}") for n in (1, 2, 3) for ext in ("png", "exr")]
+        self.assert_ok(proc, *outputs)
+        self.assertIn("3 of 3 frames written", proc.stdout, self.detail(proc))
+        # POV-Ray's clock: 0, 0.5, 1 over frames 1-3 (the default Initial/Final_Clock 0 and 1).
+        for frame, clock in ((1, 0.0), (2, 0.5), (3, 1.0)):
+            self.assertAlmostEqual(self.wall_distance(self.path(f"out{frame}.exr")),
+                                   6.0 - 2.0 * clock, delta=(6.0 - 2.0 * clock) * 2e-3)
+        # A frame equals the still rendered at its clock, bit for bit.
+        still = self.run_bridge(scene, *self.SIZE, "+K0.5", "--radius", "0.5", "-o",
+                                self.path("still.png"), "--exr", self.path("still.exr"))
+        self.assert_ok(still)
+        frame_names, frame_pixels = read_image(self.path("out2.exr"))
+        still_names, still_pixels = read_image(self.path("still.exr"))
+        self.assertEqual(frame_names, still_names)
+        np.testing.assert_array_equal(frame_pixels, still_pixels)
+
+    def test_subset_padding_and_patterns(self):
+        scene = self.copy_scene("moving.pov", self.SCENE)
+        # Frames 9 and 10 of 1-10: two digits as POV-Ray pads them; a #### pattern takes four.
+        proc = self.run_bridge(scene, *self.SIZE, "+KFI1", "+KFF10", "+SF9", "+EF10", "--radius",
+                               "0.5", "-o", self.path("out.png"), "--exr",
+                               self.path("z.####.exr"))
+        self.assert_ok(proc, self.path("out09.png"), self.path("out10.png"),
+                       self.path("z.0009.exr"), self.path("z.0010.exr"))
+        self.assertEqual(sorted(f for f in os.listdir(self.dir) if f.startswith(("out", "z."))),
+                         ["out09.png", "out10.png", "z.0009.exr", "z.0010.exr"])
+        # Frame 9 of 1..10: clock 8/9.
+        self.assertAlmostEqual(self.wall_distance(self.path("z.0009.exr")), 6.0 - 16.0 / 9.0,
+                               delta=5e-3)
+
+    def test_a_failed_frame_leaves_the_others(self):
+        scene = self.copy_scene("moving.pov", self.SCENE)
+        proc = self.run_bridge(scene, *self.SIZE, "+KFI1", "+KFF3", "Declare=Fail=1",
+                               "--radius", "0.5", "-o", self.path("out.png"))
+        self.assertEqual(proc.returncode, 1, self.detail(proc))
+        self.assertIn("frame 2: error", proc.stderr, self.detail(proc))
+        self.assertIn("is broken on purpose", proc.stderr, self.detail(proc))
+        self.assertIn("1 of 3 frames failed: 2", proc.stderr, self.detail(proc))
+        self.assertTrue(os.path.isfile(self.path("out1.png")))
+        self.assertTrue(os.path.isfile(self.path("out3.png")))
+        self.assertFalse(os.path.exists(self.path("out2.png")))
+
+    def test_animation_usage_errors(self):
+        scene = self.copy_scene("moving.pov", self.SCENE)
+        cases = [(("+KFI1", "+KFF3"), "needs --radius"),
+                 (("+KFI5", "+KFF3", "--radius", "1"), "runs backwards"),
+                 (("+KFI1", "+KFF3", "+SF7", "--radius", "1"), "holds no frame"),
+                 (("+KFI1", "+KFF30", "+SF0.5", "--radius", "1"), "whole frame numbers")]
+        for args, phrase in cases:
+            with self.subTest(phrase=phrase):
+                out = self.path("out.png")
+                proc = self.run_bridge(scene, *self.SIZE, *args, "-o", out)
+                self.assert_fails(proc, phrase, code=2)
+                self.assertEqual([f for f in os.listdir(self.dir) if f.startswith("out")], [])
+
+
 class BadInputTest(PovTestCase):
 
     def test_missing_scene(self):
