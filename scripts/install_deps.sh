@@ -17,6 +17,7 @@ PACKAGES=(
   debootstrap                               # Blender 4.3 and 5.2 tests (Debian 13 and sid folders)
   xvfb xauth                                # the add-on tests in Blender's UI (xvfb-run)
   slurmctld slurmd slurm-client munge       # the farm test (a Slurm cluster on localhost)
+  nodejs                                    # the Flamenco job type's test (node)
 )
 
 missing=()

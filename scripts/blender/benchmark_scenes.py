@@ -22,9 +22,10 @@ Reference mode (the ground truth; also Combined, Depth and Normal passes):
         -P scripts/blender/benchmark_scenes.py -- --scene thin --out kit/thin \\
         --width 640 --height 360 --samples 1024
 
-writes PREFIX.exr, PREFIX.camera.json and PREFIX.json as make_reference_scene.py does, with
-``ao_distance`` (the radius an artist would choose for the layout) and ``triangles`` in the
-metadata. scripts/blender/cycles_ao_sweep.py renders the same scenes the fast way.
+writes PREFIX.exr, PREFIX.camera.json (export_cameras.py's camera description) and PREFIX.json
+as make_reference_scene.py does, with ``ao_distance`` (the radius an artist would choose for the
+layout) and ``triangles`` in the metadata. scripts/blender/cycles_ao_sweep.py renders the same
+scenes the fast way.
 """
 
 import argparse
@@ -37,6 +38,7 @@ import bpy
 from mathutils import Matrix, Vector
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import export_cameras  # noqa: E402
 import make_reference_scene as reference  # noqa: E402
 
 
@@ -292,7 +294,7 @@ def parse_args(argv):
 
 
 def main():
-    args = parse_args(reference.script_argv())
+    args = parse_args(export_cameras.script_argv())
     scene = bpy.context.scene
     cam_obj, layout = build_scene(scene, args.scene, args.level)
     args.ao_distance = layout["ao_distance"]
@@ -303,4 +305,4 @@ def main():
 
 
 if __name__ == "__main__":
-    reference.run_script(main, "benchmark_scenes")
+    export_cameras.run_script(main, "benchmark_scenes")

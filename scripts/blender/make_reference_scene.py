@@ -26,16 +26,20 @@ Only Cycles on the CPU is supported for now; the engine is chosen through
 """
 
 import argparse
-import json
 import math
 import os
 import sys
 import time
-import traceback
 
 import bpy
 import bmesh
 from mathutils import Euler, Matrix, Vector
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+# The camera JSON and the script helpers live in export_cameras.py (the camera exporter for
+# users' scenes); the scripts that import this module use them through it too.
+from export_cameras import (camera_description, matrix_rows, run_script,  # noqa: E402,F401
+                            script_argv, write_json)
 
 VIEW_LAYER_NAME = "ViewLayer"
 
@@ -93,13 +97,6 @@ def parse_args(argv):
     if "#" in os.path.basename(args.out):
         parser.error("--out must not contain '#' (Blender reads it as a frame number)")
     return args
-
-
-def script_argv():
-    """The arguments after '--' (Blender's own arguments come before it)."""
-    if "--" in sys.argv:
-        return sys.argv[sys.argv.index("--") + 1:]
-    return []
 
 
 # ---------------------------------------------------------------------------
@@ -359,36 +356,6 @@ def configure_render(scene, args, exr_path):
 # ---------------------------------------------------------------------------
 # Output
 
-def matrix_rows(m):
-    return [[float(m[r][c]) for c in range(len(m[r]))] for r in range(len(m))]
-
-
-def camera_description(cam_obj):
-    """The camera JSON of docs/conventions.md (fields named after bpy.types.Camera)."""
-    cam = cam_obj.data
-    return {
-        "type": cam.type,
-        "lens": float(cam.lens),
-        "sensor_width": float(cam.sensor_width),
-        "sensor_height": float(cam.sensor_height),
-        "sensor_fit": cam.sensor_fit,
-        "shift_x": float(cam.shift_x),
-        "shift_y": float(cam.shift_y),
-        "ortho_scale": float(cam.ortho_scale),
-        "clip_start": float(cam.clip_start),
-        "clip_end": float(cam.clip_end),
-        "matrix_world": matrix_rows(cam_obj.matrix_world),
-    }
-
-
-def write_json(path, data):
-    tmp = path + ".tmp"
-    with open(tmp, "w", encoding="utf-8") as f:
-        json.dump(data, f, indent=1)
-        f.write("\n")
-    os.replace(tmp, path)
-
-
 def render_reference(scene, cam_obj, args, prefix, scene_name, extra_meta=None):
     """Renders `scene` with the passes of args into PREFIX.exr and writes PREFIX.camera.json
     and PREFIX.json (metadata, plus `extra_meta`)."""
@@ -460,21 +427,6 @@ def main():
     add_sun(scene)
     cam_obj = add_camera(scene, args.camera)
     render_reference(scene, cam_obj, args, prefix, args.scene_name or os.path.basename(prefix))
-
-
-def run_script(main, name):
-    """Runs main() as a Blender script: on any error, the traceback and 'NAME: FAILED' on stderr
-    and exit status 1 (with --python-exit-code 1; Blender itself would carry on)."""
-    try:
-        main()
-    except SystemExit:
-        raise
-    except BaseException:
-        traceback.print_exc()
-        print("%s: FAILED" % name, file=sys.stderr)
-        sys.stdout.flush()
-        sys.stderr.flush()
-        sys.exit(1)
 
 
 if __name__ == "__main__":

@@ -156,14 +156,28 @@ class LocalSlurm:
         self.processes = []
 
 
-def write_shot(folder):
-    """The bundled sample render as an 11-frame shot, each frame's depth scaled a little more
-    (so that frames differ and a frame written under the wrong number is caught)."""
+def report(name, failures):
+    """Prints the failures and the closing line ctest's log shows; returns the exit status."""
+    for failure in failures:
+        print("FAIL:", failure)
+    print(f"{name}: {0 if failures else 1} passed, {1 if failures else 0} failed")
+    return 1 if failures else 0
+
+
+def write_shot(folder, frames=FRAMES, size=None):
+    """The bundled sample render as a shot, each frame's depth scaled a little more (so that
+    frames differ and a frame written under the wrong number is caught); `size` (width,
+    height) resamples it (benchmarks/farm_throughput.py)."""
     names, pixels = read_image(SAMPLE + ".exr")
+    if size is not None:
+        source = oiio.ImageBuf(pixels)
+        resized = oiio.ImageBufAlgo.resize(source, roi=oiio.ROI(0, size[0], 0, size[1], 0, 1, 0,
+                                                                pixels.shape[2]))
+        pixels = np.asarray(resized.get_pixels(oiio.FLOAT), np.float32)
     depth = names.index("ViewLayer.Depth.Z")
-    for frame in FRAMES:
+    for frame in frames:
         data = pixels.copy()
-        data[:, :, depth] *= 1.0 + 0.01 * (frame - FRAMES[0])
+        data[:, :, depth] *= 1.0 + 0.01 * (frame - frames[0])
         path = os.path.join(folder, f"render.{frame:04d}.exr")
         spec = oiio.ImageSpec(data.shape[1], data.shape[0], data.shape[2], oiio.FLOAT)
         spec.channelnames = tuple(names)
@@ -265,10 +279,7 @@ def main():
           f"(1 core per task, 2 at once): {farm_seconds:.2f} s from submission to the last task "
           f"(cluster start-up {startup_seconds:.2f} s); serial run with 2 threads "
           f"{serial_seconds:.2f} s")
-    for failure in failures:
-        print("FAIL:", failure)
-    print(f"farm: {0 if failures else 1} passed, {1 if failures else 0} failed")
-    return 1 if failures else 0
+    return report("farm", failures)
 
 
 if __name__ == "__main__":
