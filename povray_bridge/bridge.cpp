@@ -35,6 +35,9 @@ namespace fs = std::filesystem;
 using Clock = std::chrono::steady_clock;
 
 constexpr float kInfinity = std::numeric_limits<float>::infinity();
+// A depth pass whose median estimated relative error exceeds this measured nothing (a good pass:
+// about 4e-4; one without fog: 1).
+constexpr double kUnusableDepthError = 0.1;
 
 // Progress on stdout, warnings on stderr; both silenced by --quiet.
 class Reporter {
@@ -675,7 +678,23 @@ void render_image(const Options& o, const RenderSetup& setup, const AnimationFra
         100.0 * static_cast<double>(stats.geometry) / static_cast<double>(stats.total),
         distances.d3 > 0.0 ? "" : " + leaked colour", e.median, e.p99, e.max);
     // The look_at guess covers 0.02 L .. 300 L; a scene mostly outside gets a second pass.
-    if (!guessed || attempt > 0 || (e.p99 <= 2e-3 && stats.median >= 0.02 * distances.d1)) break;
+    if (!guessed || attempt > 0 || (e.p99 <= 2e-3 && stats.median >= 0.02 * distances.d1)) {
+      // Fog that never reached the pixels reads as the scene's own colour: the depths are then
+      // noise (a measured median error of 1), and AO from them would be silently wrong.
+      if (e.median > kUnusableDepthError) {
+        char buffer[32];
+        std::snprintf(buffer, sizeof buffer, "%.2g", e.median);
+        throw ssao_io::Error(
+            std::string("the depth pass measured no usable distances (median estimated error ") +
+            buffer +
+            " of the depth). POV-Ray renders no fog for a camera inside a non-hollow object, "
+            "most often a plane whose normal points away from the camera (plane { z, 10 } "
+            "behind the scene puts the camera inside it): add 'hollow' to that object (the "
+            "render does not change) or turn its normal towards the camera" +
+            (o.fog_distances ? "; or choose --fog-distances near the scene's depths" : ""));
+      }
+      break;
+    }
     distances = choose_distances(stats);
     report.warning(
         "the depths are far from the camera's look_at distance; rendering the depth "

@@ -876,6 +876,30 @@ box { -1 1 frobnicate }
         self.assertIn("Parse Error", proc.stderr, self.detail(proc))
         self.assertIn("broken.pov' line 5", proc.stderr, self.detail(proc))
 
+    def test_camera_inside_a_non_hollow_plane(self):
+        # plane { z, 10 } behind the scene: the camera is inside its half-space, POV-Ray renders
+        # no fog there and the depth pass would read the scene's colours as tiny depths. Both
+        # ways to the fog distances (look_at, and the pre-pass without it) must refuse.
+        for camera in ("look_at <0, 1, 0>", "direction z"):
+            with self.subTest(camera=camera):
+                scene = self.copy_scene("inside.pov", f"""#version 3.7;
+camera {{ location <0, 1, -5> {camera} angle 60 }}
+light_source {{ <3, 6, -8> rgb 1 }}
+plane {{ z, 10 pigment {{ rgb 0.8 }} }}
+plane {{ y, 0 pigment {{ rgb 0.6 }} }}
+sphere {{ <0, 1, 0>, 1 pigment {{ rgb 1 }} }}
+""")
+                out, exr = self.path("out.png"), self.path("out.exr")
+                proc = self.run_bridge(scene, "-o", out, "--exr", exr, "+W32", "+H24")
+                self.assert_fails(proc, "measured no usable distances", "hollow",
+                                  outputs=[out, exr])
+        # The same scene with the plane hollow: distances as they are (the sphere's front at 4).
+        text = open(scene).read().replace("rgb 0.8 } }", "rgb 0.8 } hollow }")
+        scene = self.copy_scene("hollow.pov", text)
+        proc, names, pixels, _ = self.bridge_exr(scene, size=(32, 24))
+        z = channel(names, pixels, "Z")
+        self.assertAlmostEqual(float(z[11:13, 15:17].min()), 4.0, delta=0.05, msg=self.detail(proc))
+
     def test_fisheye_camera(self):
         scene = self.copy_scene("fisheye.pov", """#version 3.7;
 camera { fisheye location <0, 1, -5> look_at 0 angle 180 }
