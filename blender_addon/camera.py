@@ -40,3 +40,19 @@ def camera_params(scene):
         "pixel_aspect_y": scene.render.pixel_aspect_y,
         "camera_to_world": [matrix[r][c] for r in range(4) for c in range(4)],
     }
+
+
+def view_frame(scene):
+    """The rendered frame in camera space, as Blender's own camera model gives it (aspect, fit
+    and shift included): (left, right, bottom, top, distance, orthographic). A perspective
+    camera's frame lies at z = -distance; an orthographic one's spans the view."""
+    camera = scene.camera
+    corners = camera.data.view_frame(scene=scene)
+    xs, ys = [c.x for c in corners], [c.y for c in corners]
+    return (min(xs), max(xs), min(ys), max(ys), -corners[0].z,
+            camera.data.type == 'ORTHO')
+
+
+def rotation(scene):
+    """The active camera's world rotation (3x3 rows, scale removed)."""
+    return [list(row) for row in scene.camera.matrix_world.to_3x3().normalized()]

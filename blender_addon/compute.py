@@ -1,5 +1,6 @@
 # SPDX-License-Identifier: MIT
 """Computing the AO: the node's exported passes in, libssao, the node's AO image out."""
+import math
 import os
 import tempfile
 import time
@@ -28,6 +29,17 @@ NODE_PARAMETERS = ("variant", "radius", "quality", "resolution", "samples", "sli
                    "power", "remap_min", "remap_max", "seed")
 
 HELPER_SCENE_PREFIX = ".SSAO recomposite "  # recomposite.py's hidden scenes
+
+# A linked Normal input is refused when fewer than this fraction of the pixels where the depth
+# describes a smooth surface have a plausible normal there: of length above 0 and at most 1 (a
+# pass averages unit normals) and on the camera's side of that surface. Measured on the test
+# scene in Blender 3.4, 4.3 and 5.2: the Render Layers' Normal pass (Cycles, EEVEE) 99.9 to 100 %,
+# also under a sub-pixel bump, which shortens Cycles' averaged normals to 0.6-0.7 and turns
+# EEVEE 4.3's up to 90 degrees from the surface (so neither the length nor a tight angle can
+# tell); the Image pass linked instead, 43 %.
+NORMAL_PLAUSIBLE_MIN = 0.75
+NORMAL_CHECK_SAMPLES = 4096  # pixels on a grid: a few ms at any size
+NORMAL_CHECK_MIN_PIXELS = 64  # fewer smooth surface pixels than this: nothing to judge by
 
 _library = None
 preferred_export_dir = ""  # set by preferences.py
@@ -108,6 +120,133 @@ def node_parameters(node):
     return {name: getattr(node, name) for name in NODE_PARAMETERS if hasattr(node, name)}
 
 
+def check_parameters(node):
+    """Blender clamps a property set out of its range but keeps NaN (measured in 3.4, 4.3 and
+    5.2: radius = inf gives 1e9, -5 gives 1e-6, nan stays nan): say which property it is."""
+    for name, value in node_parameters(node).items():
+        if isinstance(value, float) and not math.isfinite(value):
+            prop = node.bl_rna.properties[name]
+            raise RuntimeError(f"the node's property '{name}' is {value}: set a number from "
+                               f"{prop.hard_min:g} to {prop.hard_max:g}")
+
+
+def input_source(node, name):
+    """The output socket that feeds the node's input `name`, through reroutes; None when nothing
+    does (no link, or a muted one, which passes nothing)."""
+    socket = node.inputs[name]
+    while True:
+        links = [link for link in socket.links if not link.is_muted]
+        if not links:
+            return None
+        source = links[0].from_socket
+        if source.node.bl_idname != "NodeReroute":
+            return source
+        socket = source.node.inputs[0]
+
+
+def check_inputs(node):
+    """Raises when the Depth input is missing or an input is fed by an output the render does
+    not make (a Render Layers pass that is off: the compositor then feeds 0, or in 3.4 and 4.3
+    runs no export at all). Returns whether the Normal input is fed."""
+    depth, normal = input_source(node, "Depth"), input_source(node, "Normal")
+    if depth is None:
+        raise RuntimeError("the Depth input is not linked (connect the Render Layers' Depth)")
+    for name, source, pass_name in (("Depth", depth, "Z"), ("Normal", normal, "Normal")):
+        if source is not None and not source.enabled:
+            where = f"'{source.name}' of '{source.node.name}'"
+            if source.node.bl_idname == "CompositorNodeRLayers":
+                raise RuntimeError(f"the {name} input is linked to {where}, a pass this render "
+                                   "does not make: turn it on in View Layer Properties > "
+                                   f"Passes > Data > {pass_name}")
+            raise RuntimeError(f"the {name} input is linked to {where}, which is unavailable "
+                               f"(connect the Render Layers' {name})")
+    return normal is not None
+
+
+def check_depth(depth):
+    """A Depth input with no positive depth anywhere (0, negative or NaN: an unlinked-like,
+    black or broken input) would give an AO of 1 everywhere, silently."""
+    if not np.any(depth > 0):  # NaN compares false
+        raise RuntimeError("the Depth input carries no depth (every pixel is 0, negative or not "
+                           "a number): connect the Render Layers' Depth (View Layer Properties "
+                           "> Passes > Data > Z)")
+
+
+def _smooth(forward, backward):
+    """Where the surface continues alike on both sides of a pixel (no depth edge)."""
+    a, b = np.linalg.norm(forward, axis=-1), np.linalg.norm(backward, axis=-1)
+    return (np.linalg.norm(forward - backward, axis=-1) <= 0.25 * np.maximum(a, b)) & \
+        (a > 0) & (b > 0)
+
+
+def plausible_normals(scene, passes, background):
+    """(pixels checked, the fraction of them with a plausible normal: length in (0, 1.01] and on
+    the camera's side of the surface the depth describes there), on a grid of pixels where the
+    depth describes a smooth surface nearer than `background`. Positions come from Blender's
+    own camera frame (view_frame)."""
+    height, width = passes.shape[:2]
+    left, right, bottom, top, distance, ortho = camera_module.view_frame(scene)
+    step = max(1, int(math.ceil(math.sqrt(width * height / NORMAL_CHECK_SAMPLES))))
+    ys = np.arange(step, height - step, step)[:, None]
+    xs = np.arange(step, width - step, step)[None, :]
+
+    def position(x, y):  # camera space (rows bottom-up, as Blender's passes)
+        depth = passes[y, x, 3]
+        u = left + (x + 0.5) / width * (right - left)
+        v = bottom + (y + 0.5) / height * (top - bottom)
+        if not ortho:
+            u, v = u * depth / distance, v * depth / distance
+        return np.stack(np.broadcast_arrays(u, v, -depth), -1)
+
+    with np.errstate(invalid="ignore", over="ignore"):
+        centre = position(xs, ys)
+        dx1, dx0 = position(xs + step, ys) - centre, centre - position(xs - step, ys)
+        dy1, dy0 = position(xs, ys + step) - centre, centre - position(xs, ys - step)
+        depth = passes[ys, xs, 3]
+        checked = np.isfinite(depth) & (depth > 0) & (depth < background) & \
+            _smooth(dx1, dx0) & _smooth(dy1, dy0)
+        surface = np.cross(dx1 + dx0, dy1 + dy0)
+        # Its side towards the camera (the normal pass's side).
+        towards = np.array([0.0, 0.0, 1.0]) if ortho else -centre
+        surface *= np.where(np.sum(surface * towards, -1) < 0, -1.0, 1.0)[..., None]
+        normal = passes[ys, xs, 0:3] @ np.array(camera_module.rotation(scene))  # world->camera
+        length = np.linalg.norm(normal, axis=-1)
+        plausible = checked & (length > 0) & (length <= 1.01) & \
+            (np.sum(surface * normal, -1) > 0)
+    count = int(checked.sum())
+    return count, (float(plausible.sum()) / count if count else 1.0)
+
+
+def check_normals(scene, passes, background):
+    count, fraction = plausible_normals(scene, passes, background)
+    if count >= NORMAL_CHECK_MIN_PIXELS and fraction < NORMAL_PLAUSIBLE_MIN:
+        raise RuntimeError(
+            f"the Normal input does not carry this render's normals: {100 * fraction:.0f}% of "
+            f"{count} surface pixels have a normal of length at most 1 on the camera's side of "
+            "the surface the Depth describes (a Normal pass: 99% or more). Connect the Render "
+            "Layers' Normal (View Layer Properties > Passes > Data > Normal), or unlink Normal "
+            "to rebuild the normals from the depth")
+
+
+_defaults = {}
+
+
+def library_default(name):
+    """A float parameter's default, from the library's table (never repeated here)."""
+    if name not in _defaults:
+        _defaults.update({p["name"]: p["default"] for p in ssao_native.parameters(library())})
+    return _defaults[name]
+
+
+def without_ao(node, scene):
+    """A node whose AO could not be computed passes its Image through (AO 1) rather than keep
+    the AO of another frame or of earlier settings."""
+    try:
+        inner_tree.blank_ao(node, *camera_module.render_size(scene))
+    except Exception as error:
+        report(f"node '{node.name}': resetting its AO to 1 failed: {error}", error=True)
+
+
 def threads(scene):
     """The render's thread count when it is fixed (Render Properties > Performance), else 0:
     every core."""
@@ -117,13 +256,20 @@ def threads(scene):
 
 def compute_node(node, scene, passes):
     """AO of `node` from exported `passes` (bottom-up RGBA: normal xyz, depth); fills the node's
-    AO image and returns the AO with row 0 on top."""
-    if not node.inputs["Depth"].is_linked:
-        raise RuntimeError("the Depth input is not linked (connect the Render Layers' Depth)")
+    AO image and returns the AO with row 0 on top. Raises, leaving the AO image as it was, when
+    the inputs, the parameters or the library cannot give this frame's AO."""
+    use_normals = check_inputs(node)
+    check_parameters(node)
+    camera = camera_module.camera_params(scene)
+    background = EEVEE_BACKGROUND_DEPTH if compat.is_eevee(scene) else \
+        library_default("background_depth")
+    check_depth(passes[:, :, 3])
+    if use_normals:
+        check_normals(scene, passes, min(background, camera["clip_end"] or math.inf))
     height, width = passes.shape[:2]
     rgba = np.empty((height, width, 4), np.float32)
     with ssao_native.Job(library()) as job:
-        for name, value in camera_module.camera_params(scene).items():
+        for name, value in camera.items():
             job.set(name, value)
         if compat.is_eevee(scene):
             job.set("background_depth", EEVEE_BACKGROUND_DEPTH)
@@ -132,7 +278,7 @@ def compute_node(node, scene, passes):
             job.set(name, value)
         # Blender's rows run bottom-up: flipped views read and write in place.
         job.set_image("depth", passes[::-1, :, 3])
-        if node.inputs["Normal"].is_linked:
+        if use_normals:
             job.set_image("normal", passes[::-1, :, 0:3])
         job.set_image("ao", rgba[::-1])
         job.run()
@@ -145,16 +291,20 @@ def compute_node(node, scene, passes):
     return np.ascontiguousarray(rgba[::-1, :, 0])
 
 
-def compute_frame(scene, frame, since=0.0):
+def compute_frame(scene, frame, since=0.0, outcome="written"):
     """Computes every SSAO node of `scene` from its export of `frame` written since `since` (a
     time.time(); a render that started before the add-on turned a saved file's group nodes
-    back into SSAO nodes exports where the file was saved). Returns {node name: AO}; errors
-    are reported on the node and in the console."""
+    back into SSAO nodes exports where the file was saved). Returns {node name: AO, or None
+    where it failed}. A node that failed gets an AO of 1 (the frame is `outcome` without its
+    AO), and the error is reported on the node and in the console."""
     done = {}
     for node in ssao_nodes(scene):
         # A render of this session may have exported where a saved file points (see above).
         path = inner_tree.export_path(node, frame, (SAVED_EXPORT_DIR,) if since else (), since)
         try:
+            # Before the export: a Render Layers pass that is off can stop the export in 3.4
+            # and 4.3, and the node should say which.
+            check_inputs(node)
             if path is None:
                 raise RuntimeError(compat.compositor_cannot_export(scene) or
                                    f"no exported passes for frame {frame} (is the node's output "
@@ -167,8 +317,11 @@ def compute_frame(scene, frame, since=0.0):
                    f"mean AO {float(ao.mean()):.4f}")
             done[node.name] = ao
         except Exception as error:
+            done[node.name] = None
+            without_ao(node, scene)
             node.status = f"Error: {error}"
-            report(f"{scene.name} frame {frame} node '{node.name}': {error}", error=True)
+            report(f"{scene.name} frame {frame} node '{node.name}': {outcome} WITHOUT AO: "
+                   f"{error}", error=True)
     return done
 
 
@@ -188,4 +341,8 @@ def compute_ao(scene=None, node=None, render=True):
     path = inner_tree.export_path(node, scene.frame_current)
     if path is None:
         raise RuntimeError(f"no exported passes for frame {scene.frame_current}: render first")
-    return compute_node(node, scene, read_export(path))
+    try:
+        return compute_node(node, scene, read_export(path))
+    except Exception:
+        without_ao(node, scene)
+        raise

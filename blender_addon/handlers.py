@@ -32,10 +32,16 @@ _render_started = 0.0   # time.time() of the last render's start: older exports 
 
 
 def ao_layers(aos):
-    """Multilayer names of the nodes' AO: SSAO.AO for one node, SSAO.<node name> for more."""
+    """Multilayer names of the nodes' AO ({node name: AO, or None where it failed}): SSAO.AO
+    for one node, SSAO.<node name> for more. A node that failed gets no layer."""
     if len(aos) == 1:
-        return {"SSAO.AO": next(iter(aos.values()))}
-    return {"SSAO." + re.sub(r"[.\s]+", "_", name): ao for name, ao in aos.items()}
+        return {"SSAO.AO": ao for ao in aos.values() if ao is not None}
+    return {"SSAO." + re.sub(r"[.\s]+", "_", name): ao for name, ao in aos.items()
+            if ao is not None}
+
+
+def _computed(aos):
+    return any(ao is not None for ao in aos.values())
 
 
 def _written_output(scene):
@@ -85,6 +91,13 @@ def _on_render_pre(scene, *_):
     # A file loaded before the add-on registered (5.x: `blender -b file --addons ...` registers
     # with bpy.data out of reach) still carries its nodes as group nodes: turn them back now.
     set_up_nodes()
+    # The render composites with the AO the nodes hold (the last frame's, or one saved in the
+    # file), and Blender writes that composite when the add-on cannot write the frame again
+    # (its AO failed, or the re-composite did): make it the image without AO. A movie is
+    # left as it is: its frames can only ever get the AO of the frame before (docs/blender.md).
+    if not compat.is_movie(scene.render.image_settings):
+        for node in compute.ssao_nodes(scene):
+            compute.without_ao(node, scene)
 
 
 @bpy.app.handlers.persistent
@@ -100,7 +113,8 @@ def _on_render_post(scene, *_):
     # Headless, the scene's objects (the camera) still hold the frame the file was saved at.
     scene.frame_set(frame)
     aos = compute.compute_frame(scene, frame, _render_started)
-    if not aos or compat.is_movie(scene.render.image_settings):
+    # Nothing computed: the render's own composite is already the image without AO.
+    if not _computed(aos) or compat.is_movie(scene.render.image_settings):
         return
     passes = recomposite.passes_path(scene, frame)
     try:
@@ -108,7 +122,8 @@ def _on_render_post(scene, *_):
         recomposite.recomposite(scene, passes)
         _recomposited[(scene.name, frame)] = (passes, ao_layers(aos))
     except Exception as error:
-        report(f"re-compositing frame {frame} failed: {error}", error=True)
+        report(f"{scene.name} frame {frame}: written WITHOUT AO: re-compositing it failed: "
+               f"{error}", error=True)
         _remove(passes)
 
 
@@ -140,14 +155,15 @@ def _on_render_write(scene, *_):
     try:
         output = _written_output(scene)
         if output is None:
-            report("cannot find the file this render wrote; it keeps the composite without AO",
-                   error=True)
+            report(f"{scene.name} frame {frame}: cannot find the file this render wrote; it "
+                   "keeps the composite WITHOUT AO", error=True)
             return
         # The helper's Render Result holds the re-composited frame.
         helper = recomposite.helper_scene_if_any(scene)
         recomposite.write_output(scene, helper, output, passes, layers)
     except Exception as error:
-        report(f"writing frame {frame} with AO failed: {error}", error=True)
+        report(f"{scene.name} frame {frame}: written WITHOUT AO: writing it with AO failed: "
+               f"{error}", error=True)
     finally:
         _remove(passes)
 
@@ -180,11 +196,14 @@ def _finish_rendered_frames():
         try:
             scene.frame_set(frame)
             aos = compute.compute_frame(scene, frame, _render_started)
+            # Written again even when every node failed: the file has the AO of the frame
+            # before, and must get none (the failed nodes' AO is now 1).
             if aos:
                 helper = recomposite.recomposite(scene, passes)
                 recomposite.write_output(scene, helper, output, passes, ao_layers(aos))
         except Exception as error:
-            report(f"frame {frame}: writing it with AO failed: {error}", error=True)
+            report(f"{scene_name} frame {frame}: writing it again failed, it may keep the AO "
+                   f"of the frame before: {error}", error=True)
         finally:
             scene.frame_set(current)
             _remove(passes)
@@ -199,17 +218,19 @@ def _finish_rendered_frames():
     try:
         if last[1] != current:
             scene.frame_set(last[1])
-        computed = compute.compute_frame(scene, last[1], _render_started)
+        aos = compute.compute_frame(scene, last[1], _render_started, outcome="shown")
     finally:
         if scene.frame_current != current:
             scene.frame_set(current)
-    if computed:
+    # A failed node's AO is now 1: re-composite too, or the Render Result keeps an older AO.
+    if aos:
         nudge_until_composited(scene)
-        if not _compositor_editor_open():
+        if _computed(aos) and not _compositor_editor_open():
             message = ("AO computed; open a compositor Node Editor (and an Image Editor "
                        "showing Render Result) to see it applied")
             for node in compute.ssao_nodes(scene):
-                node.status = message
+                if aos.get(node.name) is not None:  # a failed node keeps its error
+                    node.status = message
             report(message)
 
 
@@ -273,10 +294,12 @@ def parameter_changed(node, scene):
     try:
         compute.compute_node(node, scene, compute.read_export(path))
         node.status = f"Frame {scene.frame_current}: recomputed"
-        nudge_until_composited(scene)
     except Exception as error:
+        compute.without_ao(node, scene)
         node.status = f"Error: {error}"
-        report(str(error), error=True)
+        report(f"{scene.name} frame {scene.frame_current} node '{node.name}': shown WITHOUT "
+               f"AO: {error}", error=True)
+    nudge_until_composited(scene)
 
 
 def _each_node(action, what):

@@ -146,6 +146,15 @@ def ao_image(node, width, height):
     return image
 
 
+def blank_ao(node, width, height):
+    """Sets the node's AO image to 1, so that the node passes its Image through unchanged: what
+    a frame whose AO could not be computed gets, rather than the AO of another frame."""
+    image = ao_image(node, width, height)
+    image.pixels.foreach_set(np.ones(width * height * 4, np.float32))
+    image.update()
+    image.update_tag()  # 5.x's GPU compositor keeps its own copy (see compute.py)
+
+
 def nudge(node):
     """Changing a built-in node's value makes the UI compositor run again on the existing render
     (Python properties and update_tag() do not)."""

@@ -18,11 +18,13 @@ class SSAO_OT_recompute(bpy.types.Operator):
 
     def execute(self, context):
         scene = context.scene
-        if not compute.compute_frame(scene, scene.frame_current):
-            errors = [n.status for n in compute.ssao_nodes(scene)]
+        aos = compute.compute_frame(scene, scene.frame_current, outcome="shown")
+        if aos:  # a node that failed now passes its Image through: re-composite that too
+            handlers.nudge_until_composited(scene)
+        if not aos or None in aos.values():
+            errors = [n.status for n in compute.ssao_nodes(scene) if n.status.startswith("Error")]
             self.report({'ERROR'}, "; ".join(errors) or "nothing to compute")
             return {'CANCELLED'}
-        handlers.nudge_until_composited(scene)
         self.report({'INFO'}, "SSAO recomputed")
         return {'FINISHED'}
 

@@ -167,8 +167,9 @@ def recomposite(scene, path):
 def write_output(scene, helper, path, passes, ao_layers):
     """Writes the re-composited frame to `path` in `scene`'s output format. A multilayer EXR gets
     every pass of the render (`passes`, the saved passes file), the new Composite and one layer
-    per SSAO node (`ao_layers`: {layer name: AO array, row 0 on top}); any other format gets the
-    composite (each scene has its own Render Result: the new one is the helper's)."""
+    per SSAO node that computed (`ao_layers`: {layer name: AO array, row 0 on top}); any other
+    format gets the composite (each scene has its own Render Result: the new one is the
+    helper's)."""
     if compat.image_format(scene.render.image_settings) == 'OPEN_EXR_MULTILAYER':
         composite_path = path + ".composite.exr"
         _save_render_as(helper, composite_path, 'OPEN_EXR', color_depth='32', codec='NONE',
@@ -180,8 +181,18 @@ def write_output(scene, helper, path, passes, ao_layers):
         finally:
             os.remove(composite_path)
     else:
-        bpy.data.images["Render Result"].save_render(path, scene=helper)
-    compute.report(f"wrote {path} with AO")
+        # Through a temporary file (the same extension): a write that fails half-way leaves
+        # the frame Blender wrote, not a partial file (multilayer.write does the same).
+        root, extension = os.path.splitext(path)
+        temporary = f"{root}.ssao-partial{extension}"
+        try:
+            bpy.data.images["Render Result"].save_render(temporary, scene=helper)
+            os.replace(temporary, path)
+        finally:
+            if os.path.exists(temporary):
+                os.remove(temporary)
+    # No layer: every node failed (their AO is 1), which compute_frame has reported.
+    compute.report(f"wrote {path} " + ("with AO" if ao_layers else "WITHOUT AO"))
 
 
 def remove_helpers():

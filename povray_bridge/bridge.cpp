@@ -927,6 +927,14 @@ void run_render(const Options& o) {
     if (height == 0) height = h;
   }
   default_size(scene_folder, width, height);
+  // POV-Ray would render a size this large for hours before anything failed; each of the
+  // passes, the AO buffers and the outputs hold it as float (about 64 bytes a pixel in all).
+  constexpr double kMaxPixels = 8192.0 * 8192.0;
+  if (width > 65536 || height > 65536 || double(width) * double(height) > kMaxPixels) {
+    throw ssao_io::Error("the image size " + std::to_string(width) + "x" + std::to_string(height) +
+                         " is over povray-ssao's limit of " +
+                         "67108864 pixels (8192 x 8192, about 4 GB of passes)");
+  }
 
   // The camera, from the scene text (and its include files, found as POV-Ray finds them).
   const std::string includes = include_folder();

@@ -192,9 +192,10 @@ bool size_switch(const std::string& arg, Options& out) {
   if (arg.size() < 3 || (arg[0] != '+' && arg[0] != '-')) return false;
   const char key = static_cast<char>(std::toupper(static_cast<unsigned char>(arg[1])));
   if (key != 'W' && key != 'H') return false;
-  if (!std::all_of(arg.begin() + 2, arg.end(), [](unsigned char c) { return std::isdigit(c); })) {
-    return false;
-  }
+  // A size with a sign or a fraction (+H-5, +W1.5) is a bad size, not another POV-Ray switch
+  // (+HI, Include_Header, starts with a letter).
+  const unsigned char first = static_cast<unsigned char>(arg[2]);
+  if (!std::isdigit(first) && first != '-' && first != '+' && first != '.') return false;
   const int value = parse_size(arg, arg.substr(2));
   (key == 'W' ? out.width : out.height) = value;
   return true;

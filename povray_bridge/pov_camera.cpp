@@ -102,11 +102,16 @@ const std::set<std::string>& modifier_keywords() {
   return words;
 }
 
+// How deep declared cameras and transforms may refer to others: the scan keeps their tokens, not
+// their values, so "#declare C = camera { C }" (or two that name each other) would recurse
+// forever (a stack overflow found by tests/fuzz/fuzz_pov_scene). Real scenes use one or two.
+constexpr int kMaxDeclaredDepth = 16;
+
 class BlockParser {
  public:
   BlockParser(std::vector<Token> tokens, const Symbols& symbols, int width, int height,
-              double clock, std::string block_location)
-      : tokens_(std::move(tokens)), block_location_(std::move(block_location)) {
+              double clock, std::string block_location, int depth = 0)
+      : tokens_(std::move(tokens)), block_location_(std::move(block_location)), depth_(depth) {
     Token end;
     end.kind = Token::kEnd;
     end.file = tokens_.empty() ? "" : tokens_.back().file;
@@ -127,8 +132,10 @@ class BlockParser {
       if (found != symbols_.end() && found->second.kind == Symbol::kCamera) {
         // camera { Declared ... }: POV-Ray 3.5+ copies the declared camera and then accepts
         // only transformations.
+        check_depth(tokens_[0]);
         BlockParser inner(found->second.tokens, symbols_, context_.image_width,
-                          context_.image_height, context_.clock, found->second.declared_at);
+                          context_.image_height, context_.clock, found->second.declared_at,
+                          depth_ + 1);
         Spec declared = inner.parse(false);
         spec.base = resolve_declared(declared, found->second.declared_at);
         spec.focal_blur = declared.focal_blur;
@@ -148,6 +155,14 @@ class BlockParser {
 
   [[noreturn]] void fail_at(const Token& token, const std::string& message) {
     throw EvalError(where(token) + ": " + message);
+  }
+
+  void check_depth(const Token& token) {
+    if (depth_ >= kMaxDeclaredDepth) {
+      fail_at(token, "'" + token.text + "' is a declared camera or transform that refers to " +
+                         "itself (or declared ones nest deeper than " +
+                         std::to_string(kMaxDeclaredDepth) + " levels)");
+    }
   }
 
   // Skips to the next modifier keyword or directive after an unreadable value.
@@ -240,8 +255,10 @@ class BlockParser {
           fail_at(tokens_[pos],
                   "'" + tokens_[pos].text + "' is not a transform { } declared before the camera");
         }
+        check_depth(tokens_[pos]);
         BlockParser inner(found->second.tokens, symbols_, context_.image_width,
-                          context_.image_height, context_.clock, found->second.declared_at);
+                          context_.image_height, context_.clock, found->second.declared_at,
+                          depth_ + 1);
         const Spec declared = inner.parse(true);
         if (!declared.errors.empty()) throw EvalError(declared.errors.front());
         for (const Affine& a : declared.transforms) add_transform(spec, a, keyword);
@@ -413,6 +430,7 @@ class BlockParser {
 
   std::vector<Token> tokens_;
   std::string block_location_;
+  int depth_ = 0;  // how many declared cameras or transforms enclose this block
   Symbols symbols_;
   EvalContext context_;
   Conditionals conditionals_;
@@ -554,6 +572,16 @@ ResolvedCamera resolve(const Spec& spec, const CameraOverrides& overrides,
   camera.right = all.direction(right);
   camera.up = all.direction(up);
 
+  // povray-ssao writes these vectors into every pass's scene and libssao's camera: a value
+  // that overflowed (e.g. location <1e308 * 10, 0, 0>) would reach them as inf or nan (found by
+  // tests/fuzz/fuzz_pov_scene).
+  auto finite = [](V3 v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); };
+  if (!finite(camera.location) || !finite(camera.direction) || !finite(camera.right) ||
+      !finite(camera.up) || !std::isfinite(camera.look_at_distance)) {
+    throw EvalError(
+        "the camera's location, direction, right or up vector is not finite (a value "
+        "overflows)");
+  }
   if (!(length(camera.direction) > 0.0) || !(length(camera.right) > 0.0) ||
       !(length(camera.up) > 0.0)) {
     throw EvalError("the camera's direction, right or up vector has zero length");

@@ -4,6 +4,7 @@
 #include <fcntl.h>
 #include <poll.h>
 #include <sys/inotify.h>
+#include <sys/prctl.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -100,6 +101,7 @@ RunningProcess::RunningProcess(const std::string& executable, const std::vector<
   argv.push_back(nullptr);
 
   start_ = std::chrono::steady_clock::now();
+  const pid_t parent = ::getpid();
   child_ = ::fork();
   if (child_ < 0) {
     ::close(log);
@@ -107,6 +109,12 @@ RunningProcess::RunningProcess(const std::string& executable, const std::vector<
   }
   if (child_ == 0) {
     // The child: only async-signal-safe calls until exec.
+    // A povray-ssao killed outright (SIGKILL from a test's or a farm's time limit) cannot stop
+    // its renders; the kernel does it for it, or they would render on for nothing, for hours at
+    // a large size. If it died before this line, the child is already an orphan: stop. (The
+    // signal follows the thread that forked: renders are started from the main thread only.)
+    ::prctl(PR_SET_PDEATHSIG, SIGKILL);
+    if (::getppid() != parent) ::_exit(125);
     const int null_in = ::open("/dev/null", O_RDONLY);
     if (null_in >= 0) ::dup2(null_in, 0);
     ::dup2(log, 1);

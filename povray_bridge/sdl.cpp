@@ -375,7 +375,24 @@ class Parser {
     return left;
   }
 
+  // Every nesting (parentheses, vectors, function arguments, signs and !) goes through unary():
+  // its depth is bounded so that a hostile or broken scene ("((((...", "----...") is an
+  // error, not a stack overflow (found by tests/fuzz/fuzz_pov_scene). Real scenes nest a few
+  // levels.
+  static constexpr int kMaxNesting = 200;
+  struct NestingGuard {
+    explicit NestingGuard(int& depth) : depth_(depth) { ++depth_; }
+    ~NestingGuard() { --depth_; }
+    NestingGuard(const NestingGuard&) = delete;
+    NestingGuard& operator=(const NestingGuard&) = delete;
+    int& depth_;
+  };
+
   SdlValue unary() {
+    const NestingGuard guard(nesting_);
+    if (nesting_ > kMaxNesting) {
+      fail(peek(), "the expression nests deeper than " + std::to_string(kMaxNesting) + " levels");
+    }
     if (is_punct(peek(), "-")) {
       next();
       return combine(number(0.0), unary(), '-');
@@ -590,6 +607,7 @@ class Parser {
   const std::vector<Token>& tokens_;
   size_t& pos_;
   const EvalContext& context_;
+  int nesting_ = 0;
 };
 
 }  // namespace
@@ -985,6 +1003,18 @@ class Scanner {
       result.missing_includes.push_back(name);
       return;
     }
+    // Include files read in all: a file that includes itself twice (or two that include each
+    // other) would otherwise be read 2^16 times down to the depth limit, a scan of minutes
+    // where POV-Ray stops at once (found by tests/fuzz/fuzz_pov_scene). Real scenes read tens.
+    if (++includes_read_ > kMaxIncludesRead) {
+      if (includes_read_ == kMaxIncludesRead + 1) {
+        result.notes.push_back("more than " + std::to_string(kMaxIncludesRead) +
+                               " include files read (files that include each other?); the "
+                               "others, from '" +
+                               name + "' on, are not read");
+      }
+      return;
+    }
     // An include starts and ends outside any conditional of its own.
     Conditionals saved = conditionals_;
     const size_t saved_settings_end = settings_end_;
@@ -1086,7 +1116,9 @@ class Scanner {
     return is_punct(tokens[j], ";") ? j + 1 : j;
   }
 
+  static constexpr int kMaxIncludesRead = 256;
   const ScanSettings& settings_;
+  int includes_read_ = 0;
   size_t settings_end_ = 0;  // index after the global_settings block being read (this file)
   Symbols symbols_;
   EvalContext context_;

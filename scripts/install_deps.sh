@@ -5,6 +5,7 @@ set -euo pipefail
 
 PACKAGES=(
   g++ cmake ninja-build pkg-config clang-format   # build, style check
+  clang-14 libfuzzer-14-dev libclang-rt-14-dev    # fuzzing (scripts/fuzz.sh: libFuzzer, sanitizers)
   libgtest-dev                              # unit tests
   libtbb-dev                                # the library's thread pool (oneTBB)
   libhwy-dev                                # the library's SIMD kernels (Highway)

@@ -139,6 +139,18 @@ void attach_images(ssao_io::Job& job, Inputs& in, Outputs& out) {
   }
 }
 
+// World-space normals are turned through the camera's matrix: a camera file without one would
+// leave them unturned and the AO silently wrong, so such a run is refused.
+void require_camera_for_normals(const ssao_io::Job& job, const Inputs& in,
+                                const ssao_io::Camera& camera, const std::string& camera_path) {
+  if (in.normal.empty() || camera.has_matrix_world) return;
+  if (job.get_string("normal_space") != "world") return;
+  throw ssao_io::Error("camera file '" + camera_path +
+                       "': missing key 'matrix_world', which the world-space normal pass needs; " +
+                       "add it, or pass --normal-space camera for view-space normals, or " +
+                       "--no-normals to reconstruct normals from depth");
+}
+
 // Runs the job with progress on stderr; returns the time spent in milliseconds.
 double compute_ao(ssao_io::Job& job, bool quiet) {
   ProgressReporter progress(quiet);
@@ -350,6 +362,7 @@ void run_sequence(const Options& options) {
         ssao_io::apply_params(job, o.params);
         Outputs out;
         attach_images(job, f.in, out);
+        require_camera_for_normals(job, f.in, f.camera, o.camera);
         choose_radius(o, f.camera, job);
         job.set_progress(&ProgressReporter::callback, &interrupt);
         const ssao_status result = ssao_job_run(job.get());
@@ -451,6 +464,7 @@ void run_ssao(const Options& options) {
   Inputs in = load_inputs(options);
   Outputs out;
   attach_images(job, in, out);
+  require_camera_for_normals(job, in, camera, options.camera);
   choose_radius(options, camera, job);
   const double milliseconds = compute_ao(job, options.quiet);
   write_output(options, in, out);

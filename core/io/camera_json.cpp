@@ -45,6 +45,30 @@ class Reader {
     if (it != root_.end()) out = finite_number(*it, key);
   }
 
+  // A key the projection depends on: absent is an error, never a default (a default would
+  // give a plausible but wrong image). `what` says what the key is, for the message.
+  void required_number(const char* key, double& out, const char* what) const {
+    if (!root_.contains(key)) {
+      throw Error("camera file '" + source_ + "': missing key '" + key + "' (" + what +
+                  "); scripts/blender/export_cameras.py writes every key");
+    }
+    number(key, out);
+  }
+
+  void positive(const char* key, double value) const {
+    if (root_.contains(key) && !(value > 0.0)) fail(key, "must be positive, got " + text(value));
+  }
+
+  void not_negative(const char* key, double value) const {
+    if (root_.contains(key) && value < 0.0) fail(key, "must not be negative, got " + text(value));
+  }
+
+  static std::string text(double value) {
+    std::ostringstream out;
+    out << value;
+    return out.str();
+  }
+
   void choice(const char* key, std::string& out, const std::vector<std::string>& choices,
               bool required) const {
     const auto it = root_.find(key);
@@ -78,6 +102,9 @@ class Reader {
         out[row * 4 + col] = finite_number(r[col], std::string(key) + "[" + std::to_string(row) +
                                                        "][" + std::to_string(col) + "]");
       }
+    }
+    if (out[12] != 0.0 || out[13] != 0.0 || out[14] != 0.0 || out[15] != 1.0) {
+      fail(key, "must be an affine transform: its last row must be [0, 0, 0, 1]");
     }
   }
 
@@ -119,23 +146,44 @@ Camera parse_camera_json(const std::string& text, const std::string& source) {
   Camera camera;
   const Reader read(root, source);
   read.choice("type", camera.type, {"PERSP", "ORTHO"}, true);
-  read.number("lens", camera.lens);
-  read.number("sensor_width", camera.sensor_width);
-  read.number("sensor_height", camera.sensor_height);
-  read.choice("sensor_fit", camera.sensor_fit, {"AUTO", "HORIZONTAL", "VERTICAL"}, false);
-  read.number("shift_x", camera.shift_x);
-  read.number("shift_y", camera.shift_y);
-  read.number("ortho_scale", camera.ortho_scale);
+  read.choice("sensor_fit", camera.sensor_fit, {"AUTO", "HORIZONTAL", "VERTICAL"}, true);
+  const bool perspective = camera.type == "PERSP";
+  // Only the keys this camera's projection reads are required (Blender's own rule: AUTO and
+  // HORIZONTAL fit sensor_width, VERTICAL fits sensor_height; ORTHO reads ortho_scale instead).
+  if (perspective) {
+    read.required_number("lens", camera.lens, "the focal length in mm");
+    if (camera.sensor_fit == "VERTICAL") {
+      read.required_number("sensor_height", camera.sensor_height,
+                           "the sensor height in mm, which a VERTICAL fit uses");
+      read.number("sensor_width", camera.sensor_width);
+    } else {
+      read.required_number("sensor_width", camera.sensor_width, "the sensor width in mm");
+      read.number("sensor_height", camera.sensor_height);
+    }
+    read.number("ortho_scale", camera.ortho_scale);
+  } else {
+    read.required_number("ortho_scale", camera.ortho_scale,
+                         "the view's width in scene units, which an ORTHO camera needs");
+    read.number("lens", camera.lens);
+    read.number("sensor_width", camera.sensor_width);
+    read.number("sensor_height", camera.sensor_height);
+  }
+  read.required_number("shift_x", camera.shift_x, "the horizontal lens shift; 0 for none");
+  read.required_number("shift_y", camera.shift_y, "the vertical lens shift; 0 for none");
   read.number("clip_start", camera.clip_start);
   read.number("clip_end", camera.clip_end);
   read.number("pixel_aspect_x", camera.pixel_aspect_x);
   read.number("pixel_aspect_y", camera.pixel_aspect_y);
   read.matrix("matrix_world", camera.matrix_world);
+  camera.has_matrix_world = root.contains("matrix_world");
   read.number("ao_distance", camera.ao_distance);
-  if (root.contains("ao_distance") && !(camera.ao_distance > 0.0)) {
-    throw Error("camera file '" + source + "': key 'ao_distance' must be positive, got " +
-                std::to_string(camera.ao_distance));
+  for (const char* key : {"lens", "sensor_width", "sensor_height", "ortho_scale", "clip_end",
+                          "pixel_aspect_x", "pixel_aspect_y", "ao_distance"}) {
+    double value = 0.0;
+    read.number(key, value);
+    read.positive(key, value);
   }
+  read.not_negative("clip_start", camera.clip_start);
 
   for (const auto& item : root.items()) {
     bool known = false;

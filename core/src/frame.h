@@ -32,7 +32,9 @@ struct FrameInputs {
 // offset), so loops over pixels vectorise.
 // v in [-1, 1] rounded to 16 bits (two's complement) in the low half of the result.
 inline uint32_t snorm16(float v) {
-  const float clamped = v < -1.0f ? -1.0f : (v > 1.0f ? 1.0f : v);
+  // NaN (an unusable normal, which the caller replaces) clamps to -1: converting NaN to an
+  // integer is undefined behaviour (found by tests/fuzz/fuzz_api). Other values as before.
+  const float clamped = v >= -1.0f ? (v <= 1.0f ? v : 1.0f) : -1.0f;
   const float scaled = clamped * 32767.0f;
   return uint32_t(int32_t(scaled + (scaled >= 0.0f ? 0.5f : -0.5f))) & 0xffffu;
 }

@@ -39,6 +39,22 @@ CameraParams camera_params(const ParamValues& v) {
   return c;
 }
 
+// World-space normals are turned into view space through camera_to_world's 3x3 part; a
+// singular one (zero or parallel axes) would flatten them into wrong normals without a word.
+// The determinant is compared with the product of the column lengths: scale does not matter.
+void require_invertible_rotation(const std::vector<double>& m) {
+  const auto column = [&](int c) {
+    return std::sqrt(m[c] * m[c] + m[4 + c] * m[4 + c] + m[8 + c] * m[8 + c]);
+  };
+  const double det = m[0] * (m[5] * m[10] - m[6] * m[9]) - m[1] * (m[4] * m[10] - m[6] * m[8]) +
+                     m[2] * (m[4] * m[9] - m[5] * m[8]);
+  if (!(std::fabs(det) > 1e-6 * column(0) * column(1) * column(2))) {
+    throw_invalid_argument(
+        "camera_to_world has a singular 3x3 part (zero or parallel axes): world-space normals "
+        "cannot be turned into view space; give the camera's matrix or normal_space = camera");
+  }
+}
+
 DenoiseMode denoise_mode(const std::string& name) {
   if (name == "none") return DenoiseMode::none;
   if (name == "box4") return DenoiseMode::box4;
@@ -152,12 +168,26 @@ void Job::set_image(const char* name, float* data, int width, int height, int ch
   if (pixel_stride % std::ptrdiff_t(sizeof(float)) != 0) {
     throw_invalid_argument(what + "pixel stride must be a multiple of 4 bytes");
   }
-  if (row_stride == 0) row_stride = pixel_stride * width;
-  const std::ptrdiff_t row_bytes = pixel_stride * width;
-  if (std::abs(row_stride) < row_bytes || row_stride % std::ptrdiff_t(sizeof(float)) != 0) {
+  // Strides and sizes whose byte extent does not fit in a ptrdiff_t describe no memory, and
+  // computing their offsets would overflow (undefined behaviour; found by tests/fuzz/fuzz_api):
+  // refused before any product is formed unchecked.
+  const std::string too_large = what +
+                                "pixel stride, row stride and size span more bytes than "
+                                "an address space has";
+  std::ptrdiff_t row_bytes = 0;
+  if (__builtin_mul_overflow(pixel_stride, std::ptrdiff_t(width), &row_bytes)) {
+    throw_invalid_argument(too_large);
+  }
+  if (row_stride == 0) row_stride = row_bytes;
+  if (row_stride == std::numeric_limits<std::ptrdiff_t>::min() ||
+      std::abs(row_stride) < row_bytes || row_stride % std::ptrdiff_t(sizeof(float)) != 0) {
     throw_invalid_argument(what + "row stride " + std::to_string(row_stride) +
                            " is not a multiple of 4 of at least one row (" +
                            std::to_string(row_bytes) + " bytes)");
+  }
+  std::ptrdiff_t extent = 0;
+  if (__builtin_mul_overflow(std::abs(row_stride), std::ptrdiff_t(height), &extent)) {
+    throw_invalid_argument(too_large);
   }
   if (reinterpret_cast<std::uintptr_t>(data) % alignof(float) != 0) {
     throw_invalid_argument(what + "data is not aligned to 4 bytes");
@@ -218,6 +248,7 @@ void Job::run() {
   in.radial_depth = v.get_string("depth_kind") == "radial";
   in.world_normals = v.get_string("normal_space") == "world";
   const std::vector<double>& matrix = v.get_floats("camera_to_world");
+  if (in.normal.attached() && in.world_normals) require_invertible_rotation(matrix);
   std::copy(matrix.begin(), matrix.end(), in.camera_to_world);
   in.background_depth = static_cast<float>(
       std::min(v.get_float("background_depth"), double(std::numeric_limits<float>::max())));

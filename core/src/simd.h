@@ -4,8 +4,11 @@
 // the simple streaming loops; the kernels with gathers use Google Highway instead.
 #pragma once
 
+// Not in sanitizer builds: the clones' ifunc resolvers run while the dynamic loader relocates
+// the library, before the sanitizer's runtime is initialised, and crash there when instrumented
+// (ThreadSanitizer: a segfault before main).
 #if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) && \
-    !defined(__SANITIZE_ADDRESS__)
+    !defined(__SANITIZE_ADDRESS__) && !defined(__SANITIZE_THREAD__)
 #define SSAO_VECTORIZE __attribute__((target_clones("avx512f", "avx2", "default")))
 #else
 #define SSAO_VECTORIZE

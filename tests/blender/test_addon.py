@@ -148,9 +148,10 @@ class AddonTest(unittest.TestCase):
         return folder, ao, passes
 
     def render_frame(self, blend, folder, *args, frame=1):
-        """Renders `blend` (-f frame, or extra args) with the node's exports kept in folder."""
+        """Renders `blend` (-f frame, or only the extra args for frame=None) with the node's
+        exports kept in folder."""
         env = {"SSAO_COMPOSITOR_EXPORT_DIR": os.path.join(folder, "export")}
-        return self.blender.run(blend, *args, "-f", str(frame), env=env)
+        return self.blender.run(blend, *args, *(["-f", str(frame)] if frame else []), env=env)
 
     def assert_composite_is_beauty_times_ao(self, output_exr, passes_exr):
         out = read_exr(output_exr)
@@ -309,17 +310,23 @@ class AddonTest(unittest.TestCase):
     def test_ui_animation_writes_each_frame_with_its_own_ao(self):
         # Ctrl+F12 in the UI, where render handlers run in the render thread: every written
         # frame must carry its own AO, the one a headless render (-a) of the same frame gets.
+        # Frame 4's AO fails, with an AO of 0.5 in the node from before: its file must be the
+        # beauty (before, it kept the AO the frames were composited with during the job).
         folder = self.folder("ui_anim")
-        blend = self.blender.build_scene("ui_anim/scene", "--frames", "3",
+        blend = self.blender.build_scene("ui_anim/scene", "--frames", "4",
                                          "--output", os.path.join(folder, "out_####.exr"),
                                          "--passes-dir", os.path.join(folder, "passes"))
         env = {"SSAO_COMPOSITOR_EXPORT_DIR": os.path.join(folder, "export")}
-        log = self.blender.run_ui(blend, os.path.join(HERE, "ui_render_animation.py"), env=env)
+        log = self.blender.run_ui(blend, os.path.join(HERE, "ui_render_animation.py"),
+                                  "--fail-frame", "4", env=env)
         self.assertRegex(log, r"ui_render_animation \[ *[0-9.]+s\] done")
         self.assertEqual(log.count("with AO"), 3, log)
-        ui_aos = self.assert_frames_are_beauty_times_ao(folder, 3)
+        self.assertRegex(log, r"error: Scene frame 4 node '[^']+': written WITHOUT AO: "
+                              r"ssao_job_run: simulated library failure")
+        *ui_aos, failed_ao = self.assert_frames_are_beauty_times_ao(folder, 4)
+        np.testing.assert_array_equal(failed_ao, 1.0)
         headless = self.folder("ui_anim/headless")
-        self.blender.run(blend, "-o", os.path.join(headless, "out_####"), "-a", env={
+        self.blender.run(blend, "-o", os.path.join(headless, "out_####"), "-e", "3", "-a", env={
             "SSAO_COMPOSITOR_EXPORT_DIR": os.path.join(headless, "export")})
         for frame, ui_ao in zip((1, 2, 3), ui_aos):
             out = rgb(read_exr(os.path.join(headless, f"out_{frame:04d}.exr")))
@@ -427,6 +434,51 @@ class AddonTest(unittest.TestCase):
                      "except Exception as e:\n    print('RAISED', e)")
         log = self.blender.run(blend, "--python-exit-code", "1", "--python-expr", no_camera)
         self.assertIn("RAISED scene 'Scene' has no active camera", log)
+
+    def test_a_frame_without_its_ao_is_written_as_the_image_unchanged(self):
+        # Frames rendered one after the other, each broken frame after a frame with AO. Before,
+        # a frame whose AO failed was written with the AO the node still held (the frame
+        # before's), and inputs without depth or normals gave an AO of 1 or a wrong AO without
+        # a word. Now each such frame must be the beauty exactly, with an AO output of 1, the
+        # node's status and the log must say why, and the next frame must get its AO again.
+        folder = self.folder("broken")
+        breaks = {2: ("depth unlinked", "the Depth input is not linked"),
+                  3: ("normal from image", "the Normal input does not carry this render's "
+                                           "normals"),
+                  5: ("library fails", "simulated library failure"),
+                  6: ("no depth", "the Depth input carries no depth"),
+                  8: ("radius nan", "the node's property 'radius' is nan"),
+                  9: ("normal pass off", "Passes > Data > Normal")}
+        blend = self.blender.build_scene("broken/scene", "--frames", "9",
+                                         "--output", os.path.join(folder, "out_####.exr"),
+                                         "--passes-dir", os.path.join(folder, "passes"))
+        report_path = os.path.join(folder, "report.json")
+        log = self.render_frame(blend, folder, "--python",
+                                os.path.join(HERE, "render_broken_frames.py"), "--",
+                                report_path, *[f"{f}={case}" for f, (case, _) in breaks.items()],
+                                frame=None)
+        with open(report_path) as f:
+            report = json.load(f)
+        for frame in range(1, 10):
+            with self.subTest(frame=frame, case=breaks.get(frame, ("as saved",))[0]):
+                ao, _ = self.assert_composite_is_beauty_times_ao(
+                    os.path.join(folder, f"out_{frame:04d}.exr"),
+                    os.path.join(folder, "passes", f"{frame:04d}.exr"))
+                status = report[str(frame)]["status"]
+                if frame in breaks:
+                    np.testing.assert_array_equal(ao, 1.0)
+                    self.assertTrue(status.startswith("Error: "), status)
+                    self.assertIn(breaks[frame][1], status)
+                    self.assertRegex(log, rf"ssao_compositor: error: Scene frame {frame} node "
+                                          rf"'[^']+': written WITHOUT AO: .*"
+                                          rf"{re.escape(breaks[frame][1])}")
+                else:
+                    self.assertTrue(status.startswith(f"Frame {frame}:"), status)
+                    self.assertLess(float(ao.mean()), 0.97)
+                    # The AO itself is unchanged: the command-line tool's on the same passes.
+                    cli = self.cli_ao(folder, os.path.join(
+                        folder, f"scene.camera.{frame:04d}.json"), frame)
+                    np.testing.assert_allclose(ao, cli, atol=1e-5)
 
 
 class PackageTest(unittest.TestCase):

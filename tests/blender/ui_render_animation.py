@@ -4,10 +4,12 @@ INVOKE_DEFAULT, animation=True), waits for the render job and for the add-on's w
 then quits. Run under Xvfb by tests/blender/test_addon.py:
 
     xvfb-run -a blender --factory-startup -noaudio --addons ssao_compositor SCENE.blend \
-        --python tests/blender/ui_render_animation.py -- [--timeout 300]
+        --python tests/blender/ui_render_animation.py -- [--timeout 300] [--fail-frame N]
 
-Prints "ui_render_animation [...] done" when everything finished, and exits non-zero on a timeout or
-an exception."""
+--fail-frame N: the SSAO nodes start with an AO of 0.5 (one left by an earlier render), and the
+library fails on frame N, whose file must then get no AO at all, not that one nor another
+frame's. Prints "ui_render_animation [...] done" when everything finished, and exits non-zero on
+a timeout or an exception."""
 import sys
 import time
 import traceback
@@ -15,6 +17,8 @@ import traceback
 import bpy
 
 TIMEOUT = float(sys.argv[sys.argv.index("--timeout") + 1]) if "--timeout" in sys.argv else 300.0
+FAIL_FRAME = int(sys.argv[sys.argv.index("--fail-frame") + 1]) if "--fail-frame" in sys.argv \
+    else None
 START = time.monotonic()
 STATE = {"started": False, "idle_since": None}
 
@@ -23,13 +27,38 @@ def log(message):
     print(f"ui_render_animation [{time.monotonic() - START:6.1f}s] {message}", flush=True)
 
 
+def addon_module(name):
+    module = next((m for n, m in sys.modules.items() if n.endswith("ssao_compositor." + name)),
+                  None)
+    if module is None:
+        raise RuntimeError("the ssao_compositor add-on is not loaded")
+    return module
+
+
 def addon_busy():
     """The add-on's main-thread timer still has frames to finish."""
-    handlers = next((m for n, m in sys.modules.items() if n.endswith("ssao_compositor.handlers")),
-                    None)
-    if handlers is None:
-        raise RuntimeError("the ssao_compositor add-on is not loaded")
+    handlers = addon_module("handlers")
     return bool(handlers._written_frames or handlers._pending_frames)
+
+
+def break_frame(frame):
+    """An AO of 0.5 in every SSAO node, and a library that fails on `frame` (the AO is
+    computed on the main thread, after the render job, with the scene set to the frame)."""
+    compute, inner_tree, native = (addon_module(n) for n in ("compute", "inner_tree",
+                                                             "ssao_native"))
+    scene = bpy.context.scene
+    width, height = scene.render.resolution_x, scene.render.resolution_y
+    for node in compute.ssao_nodes(scene):
+        inner_tree.ao_image(node, width, height).pixels.foreach_set(
+            [0.5] * (width * height * 4))
+    run = native.Job.run
+
+    def failing_run(self, progress=None):
+        if bpy.context.scene.frame_current == frame:
+            raise native.SSAOError("ssao_job_run: simulated library failure")
+        return run(self, progress)
+
+    native.Job.run = failing_run
 
 
 def quit_blender(code):
@@ -46,6 +75,8 @@ def step():
             log(f"timeout after {TIMEOUT:.0f} s")
             quit_blender(1)
         if not STATE["started"]:
+            if FAIL_FRAME is not None:
+                break_frame(FAIL_FRAME)
             window = bpy.context.window_manager.windows[0]
             with bpy.context.temp_override(window=window):
                 bpy.ops.render.render('INVOKE_DEFAULT', animation=True)

@@ -597,6 +597,73 @@ class BadInputTest(CliTestCase):
         self.camera = self.path("no-camera.json")
         self.assert_fails(self.run_ssao(), 1, "no-camera.json", "no such file")
 
+    def test_camera_without_a_value_the_run_depends_on_is_refused(self):
+        # A default in place of a missing value would give a plausible, wrong image.
+        without = lambda camera, key: {k: v for k, v in camera.items() if k != key}
+        ortho = dict(CAMERA, type="ORTHO")
+        vertical = dict(CAMERA, sensor_fit="VERTICAL")
+        singular = CAMERA_TO_WORLD.copy()
+        singular[:3, 1] = singular[:3, 0]  # two parallel axes
+        projective = CAMERA_TO_WORLD.copy()
+        projective[3, 2] = 0.5
+        cases = [
+            (without(CAMERA, "lens"), "missing key 'lens'"),
+            (without(CAMERA, "sensor_width"), "missing key 'sensor_width'"),
+            (without(vertical, "sensor_height"), "missing key 'sensor_height'"),
+            (without(CAMERA, "sensor_fit"), "missing key 'sensor_fit'"),
+            (without(CAMERA, "shift_x"), "missing key 'shift_x'"),
+            (without(CAMERA, "shift_y"), "missing key 'shift_y'"),
+            (without(ortho, "ortho_scale"), "missing key 'ortho_scale'"),
+            (dict(CAMERA, lens=0.0), "'lens' must be positive"),
+            (dict(CAMERA, sensor_width=-36.0), "'sensor_width' must be positive"),
+            (dict(ortho, ortho_scale=0.0), "'ortho_scale' must be positive"),
+            (dict(CAMERA, pixel_aspect_y=-1.0), "'pixel_aspect_y' must be positive"),
+            (dict(CAMERA, clip_end=0.0), "'clip_end' must be positive"),
+            (dict(CAMERA, clip_start=-0.1), "'clip_start' must not be negative"),
+            (dict(CAMERA, ao_distance=0.0), "'ao_distance' must be positive"),
+            (dict(CAMERA, lens=None), "'lens' must be a number, got null"),
+            ('{"type": "PERSP", "lens": NaN}', "malformed JSON"),
+            (dict(CAMERA, matrix_world=projective.tolist()), "affine"),
+            (without(CAMERA, "matrix_world"), "missing key 'matrix_world'"),  # normals from pass
+        ]
+        for content, phrase in cases:
+            with self.subTest(phrase=phrase):
+                self.camera = self.write_camera(content)
+                self.assert_fails(self.run_ssao(), 1, "camera.json", phrase)
+        # The core refuses a singular matrix when world-space normals need it.
+        self.camera = self.write_camera(dict(CAMERA, matrix_world=singular.tolist()))
+        self.assert_fails(self.run_ssao(), 1, "camera_to_world", "singular")
+        self.assert_ok(self.run_ssao("--no-normals"))
+        os.remove(self.output)
+        # What is not needed is not required: an ORTHO camera has no lens, a HORIZONTAL fit no
+        # sensor height, a run without world-space normals no matrix.
+        lean = without(without(without(CAMERA, "sensor_height"), "clip_start"), "clip_end")
+        for content, args in [(without(without(ortho, "lens"), "sensor_width"), ()),
+                              (dict(lean, sensor_fit="HORIZONTAL"), ()),
+                              (without(CAMERA, "matrix_world"), ("--no-normals",)),
+                              (without(CAMERA, "matrix_world"), ("--normal-space", "camera"))]:
+            with self.subTest(content=content, args=args):
+                self.camera = self.write_camera(content)
+                self.assert_ok(self.run_ssao(*args))
+                os.remove(self.output)
+
+    def test_missing_clip_end_does_not_cut_far_geometry(self):
+        # Before, a missing clip_end became 1000 and geometry beyond it turned to background
+        # (AO 1) without a word. Scaled by 1e3, the scene's geometry lies beyond 1000.
+        scaled = {k: (v * np.float32(1000.0) if "Depth" in k else v)
+                  for k, v in self.planes.items()}
+        write_exr(self.input, scaled, BLENDER_CHANNELS)
+        camera = {k: v for k, v in CAMERA.items() if k != "clip_end"}
+        self.camera = self.write_camera(camera)
+        self.assert_ok(self.run_ssao("--ao-only", "--radius", RADIUS * 1000.0))
+        far = read_image(self.output)[1]
+        write_exr(self.input, self.planes, BLENDER_CHANNELS)
+        os.remove(self.output)
+        self.assert_ok(self.run_ssao("--ao-only"))
+        near = read_image(self.output)[1]
+        self.assertLess(float(near.min()), 0.9)  # the scene has occlusion to lose
+        np.testing.assert_allclose(far, near, atol=1e-3)
+
     def test_missing_camera_flag(self):
         proc = self.run_ssao(self.input, "-o", self.output, default_paths=False)
         self.assert_fails(proc, 2, "--camera")

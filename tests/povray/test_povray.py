@@ -25,6 +25,7 @@ import shutil
 import subprocess
 import sys
 import tempfile
+import time
 import unittest
 
 import numpy as np
@@ -899,6 +900,85 @@ sphere {{ <0, 1, 0>, 1 pigment {{ rgb 1 }} }}
         proc, names, pixels, _ = self.bridge_exr(scene, size=(32, 24))
         z = channel(names, pixels, "Z")
         self.assertAlmostEqual(float(z[11:13, 15:17].min()), 4.0, delta=0.05, msg=self.detail(proc))
+
+    def test_absurd_sizes_and_parameters_are_refused(self):
+        # Refused before POV-Ray starts (a 60000 x 60000 render would run for hours first).
+        scene = self.copy_scene("sunlit_wall.pov")
+        out = self.path("out.png")
+        ini = self.path("huge.ini")
+        with open(ini, "w") as f:
+            f.write("Width=60000\nHeight=60000\n")
+        cases = [
+            (("+W0", "+H24"), 2, "must be 1..65536"),
+            (("+W32", "+H-5"), 2, "must be 1..65536"),
+            (("+W99999", "+H24"), 2, "must be 1..65536"),
+            (("+W32", "+H1.5"), 2, "expects an integer"),
+            (("--ini", ini), 1, "67108864 pixels"),
+            (("+W32", "+H24", "--radius", "nan"), 2, "finite"),
+            (("+W32", "+H24", "--radius", "-1"), 2, "'radius' must be in"),
+            (("+W32", "+H24", "--samples", "-3"), 2, "'samples' must be in"),
+            (("+W32", "+H24", "--strength", "2"), 2, "'strength' must be in"),
+            (("+W32", "+H24", "--bias", "inf"), 2, "finite"),
+        ]
+        for args, code, phrase in cases:
+            with self.subTest(args=args):
+                proc = self.run_bridge(scene, "-o", out, *args, timeout=60)
+                self.assert_fails(proc, phrase, outputs=[out], code=code)
+
+    def test_unwritable_outputs_are_refused_before_rendering(self):
+        scene = self.copy_scene("sunlit_wall.pov")
+        blocker = self.path("a-file")
+        with open(blocker, "w") as f:
+            f.write("not a folder")
+        exr = self.path("out.exr")
+        for out in (os.path.join(blocker, "out.png"), self.path("no/such/folder/out.png"),
+                    self.path("out.xyz")):
+            with self.subTest(out=out):
+                proc = self.run_bridge(scene, "-o", out, "--exr", exr, "+W32", "+H24",
+                                       timeout=60)
+                self.assertNotEqual(proc.returncode, 0, self.detail(proc))
+                self.assertIn("povray-ssao: error:", proc.stderr, self.detail(proc))
+                self.assertFalse(os.path.exists(out))
+                self.assertFalse(os.path.exists(exr), "the --exr output of a failed run")
+        self.assertEqual(sorted(os.listdir(self.dir)), sorted(["a-file", "sunlit_wall.pov"]),
+                         "files left behind")
+
+    def test_killed_bridge_leaves_no_render_running(self):
+        # SIGKILL (a test's or a farm's time limit) gives povray-ssao no chance to stop its
+        # renders: they must not go on rendering for nothing.
+        scene = self.copy_scene("sunlit_wall.pov")
+        bridge = subprocess.Popen([BRIDGE, scene, "-o", self.path("out.png"), "+W3000",
+                                   "+H3000"], cwd=self.dir, stdout=subprocess.DEVNULL,
+                                  stderr=subprocess.DEVNULL)
+
+        def renders():
+            found = []
+            for pid in filter(str.isdigit, os.listdir("/proc")):
+                try:
+                    with open(f"/proc/{pid}/cmdline", "rb") as f:
+                        words = f.read().split(b"\0")
+                except OSError:
+                    continue
+                if words and os.path.basename(words[0]) == b"povray" and \
+                        any(self.dir.encode() in w for w in words):
+                    found.append(int(pid))
+            return found
+
+        try:
+            deadline = time.monotonic() + 30
+            while len(renders()) < 3 and time.monotonic() < deadline:
+                time.sleep(0.05)
+            self.assertEqual(len(renders()), 3, "the three passes never started")
+        finally:
+            bridge.kill()
+            bridge.wait()
+        deadline = time.monotonic() + 10
+        while renders() and time.monotonic() < deadline:
+            time.sleep(0.05)
+        left = renders()
+        for pid in left:
+            os.kill(pid, 9)
+        self.assertEqual(left, [], "POV-Ray renders outlived a killed povray-ssao")
 
     def test_fisheye_camera(self):
         scene = self.copy_scene("fisheye.pov", """#version 3.7;

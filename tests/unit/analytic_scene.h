@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: MIT
 // Depth and normal buffers ray-cast from analytic geometry, with their own camera maths
-// (independent of the core's camera model), plus a small RAII wrapper over the C API.
+// (independent of the core's camera model), the scenes the unit and stress tests share, and a
+// small RAII wrapper over the C API.
 #pragma once
 
 #include <gtest/gtest.h>
@@ -42,10 +43,12 @@ struct Camera {
   double ortho_scale = 6.0;           // ORTHO
   int width = 96, height = 64;
 
-  // Ray through the centre of pixel (x, y), y = 0 on top, in view space (-Z forward).
+  // Ray through the centre of pixel (x, y), y = 0 on top, in view space (-Z forward). The
+  // sensor (or ortho_scale) spans the larger image side, as the library's sensor_fit AUTO.
   void ray(int x, int y, V3& origin, V3& direction) const {
-    const double nx = (x + 0.5) / width - 0.5;                      // -0.5 .. 0.5
-    const double ny = (0.5 - (y + 0.5) / height) * height / width;  // same units as nx
+    const double fit = width >= height ? 1.0 : double(width) / height;    // portrait: fit height
+    const double nx = ((x + 0.5) / width - 0.5) * fit;                    // -0.5 .. 0.5 on the fit
+    const double ny = (0.5 - (y + 0.5) / height) * height / width * fit;  // same units as nx
     if (ortho) {
       origin = {nx * ortho_scale, ny * ortho_scale, 0.0};
       direction = {0.0, 0.0, -1.0};
@@ -133,6 +136,68 @@ inline double corner_ao(double x, double r) {
   return 1.0 - (std::acos(a) - a * std::sqrt(1.0 - a * a)) / M_PI;
 }
 
+// Mean, min and max of the AO over the geometry pixels that `include` accepts.
+struct Stats {
+  double mean = 0, min = 1, max = 0;
+  int count = 0;
+};
+
+inline Stats stats_over(const Scene& s, const std::vector<float>& ao,
+                        const std::function<bool(int x, int y)>& include) {
+  Stats st;
+  double sum = 0;
+  for (int y = 0; y < s.height; ++y) {
+    for (int x = 0; x < s.width; ++x) {
+      const size_t i = size_t(y) * s.width + x;
+      if (!std::isfinite(s.depth[i]) || !include(x, y)) continue;
+      sum += ao[i];
+      st.min = std::min(st.min, double(ao[i]));
+      st.max = std::max(st.max, double(ao[i]));
+      ++st.count;
+    }
+  }
+  st.mean = st.count ? sum / st.count : 0;
+  return st;
+}
+
+// A plane facing the camera at distance `depth`.
+inline Scene facing_plane(const Camera& cam, double depth = 5.0) {
+  return ray_cast(cam, {{{{0, 0, -depth}, {0, 0, 1}}}});
+}
+
+// A plane through (0, 0, -depth) turned `degrees` from facing the camera, rising away from it.
+inline Scene tilted_plane(const Camera& cam, double degrees = 60.0, double depth = 5.0) {
+  const double a = degrees * M_PI / 180.0;
+  return ray_cast(cam, {{{{0, 0, -depth}, {0, std::sin(a), std::cos(a)}}}});
+}
+
+// A 90-degree concave corner: two walls meeting along the line through `crease` in direction
+// `axis` (a unit vector across the view: {0, 1, 0} is a vertical crease), opening to the camera.
+struct Corner {
+  V3 crease{0, 0, -6};
+  V3 axis{0, 1, 0};
+};
+
+inline Scene concave_corner(const Camera& cam, const Corner& c = {}) {
+  // The union of the two half-spaces behind the walls; `side` is across the crease.
+  const V3 side{c.axis.y, -c.axis.x, 0.0};  // cross(axis, +z)
+  const V3 forward{0, 0, 1};
+  return ray_cast(cam, {{{c.crease, normalized(side + forward)}},
+                        {{c.crease, normalized(side * -1.0 + forward)}}});
+}
+
+inline double distance_to_crease(const Scene& s, int x, int y, const Corner& c = {}) {
+  const V3 p = s.point[size_t(y) * s.width + x] - c.crease;
+  const V3 across = p - c.axis * dot(p, c.axis);
+  return std::sqrt(dot(across, across));
+}
+
+// A floor with a wall behind it, seen from above at an angle: enough occlusion to compare runs.
+inline Scene floor_and_wall(const Camera& cam) {
+  return ray_cast(
+      cam, {{{{0, -1, -6}, normalized({0, 1, 0.0})}}, {{{0, 0, -8}, normalized({0, 0.2, 1})}}});
+}
+
 // RAII job over the C API; every call is checked with the library's message on failure.
 class Job {
  public:
@@ -145,6 +210,9 @@ class Job {
   void set(const char* name, int v) { check(ssao_job_set_int(job_, name, v), name); }
   void set(const char* name, double v) { check(ssao_job_set_float(job_, name, v), name); }
   void set(const char* name, const char* v) { check(ssao_job_set_string(job_, name, v), name); }
+  void set(const char* name, const std::vector<double>& v) {
+    check(ssao_job_set_floats(job_, name, v.data(), v.size()), name);
+  }
   void camera(const Camera& c) {
     set("camera_type", c.ortho ? "ORTHO" : "PERSP");
     set("lens", c.lens);

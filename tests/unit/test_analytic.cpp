@@ -11,56 +11,13 @@ using namespace test;
 
 namespace {
 
-struct Stats {
-  double mean = 0, min = 1, max = 0;
-  int count = 0;
-};
-
-Stats stats_over(const Scene& s, const std::vector<float>& ao,
-                 const std::function<bool(int x, int y)>& include) {
-  Stats st;
-  double sum = 0;
-  for (int y = 0; y < s.height; ++y) {
-    for (int x = 0; x < s.width; ++x) {
-      const size_t i = size_t(y) * s.width + x;
-      if (!std::isfinite(s.depth[i]) || !include(x, y)) continue;
-      sum += ao[i];
-      st.min = std::min(st.min, double(ao[i]));
-      st.max = std::max(st.max, double(ao[i]));
-      ++st.count;
-    }
-  }
-  st.mean = st.count ? sum / st.count : 0;
-  return st;
-}
-
 const auto everywhere = [](int, int) { return true; };
-
-Scene facing_plane(const Camera& cam) { return ray_cast(cam, {{{{0, 0, -5}, {0, 0, 1}}}}); }
-
-Scene tilted_plane(const Camera& cam) {
-  // 60 degrees from facing the camera, rising away from it.
-  const double a = 60.0 * M_PI / 180.0;
-  return ray_cast(cam, {{{{0, 0, -5}, {0, std::sin(a), std::cos(a)}}}});
-}
-
-// Two walls meeting at 90 degrees along the vertical line x = 0, z = -6, opening to the camera.
-const V3 kCrease{0, 0, -6};
-Scene concave_corner(const Camera& cam) {
-  // The union of the two half-spaces behind the walls.
-  return ray_cast(cam, {{{kCrease, normalized({1, 0, 1})}}, {{kCrease, normalized({-1, 0, 1})}}});
-}
 
 // A ridge along the vertical line x = 0, z = -5 pointing at the camera: one solid, the
 // intersection of the half-spaces behind both faces.
 Scene convex_ridge(const Camera& cam) {
   const V3 ridge{0, 0, -5};
   return ray_cast(cam, {{{ridge, normalized({1, 0, 1})}, {ridge, normalized({-1, 0, 1})}}});
-}
-
-double distance_to_crease(const Scene& s, int x, int y) {
-  const V3 p = s.point[size_t(y) * s.width + x] - kCrease;
-  return std::sqrt(p.x * p.x + p.z * p.z);
 }
 
 Camera perspective() { return Camera{}; }

@@ -14,12 +14,6 @@ using namespace test;
 
 namespace {
 
-// A floor with a wall behind it, seen from above at an angle: enough occlusion to compare runs.
-Scene floor_and_wall(const Camera& cam) {
-  return ray_cast(
-      cam, {{{{0, -1, -6}, normalized({0, 1, 0.0})}}, {{{0, 0, -8}, normalized({0, 0.2, 1})}}});
-}
-
 bool contains(const char* haystack, const char* needle) {
   return std::strstr(haystack, needle) != nullptr;
 }
@@ -472,4 +466,37 @@ TEST(Api, WorldSpaceNormalsUseTheCameraMatrix) {
     EXPECT_EQ(ssao_job_set_floats(j.get(), "camera_to_world", m, 16), SSAO_OK);
   });
   for (size_t i = 0; i < view.size(); ++i) EXPECT_NEAR(from_world[i], view[i], 1e-5f);
+}
+
+TEST(Api, SingularCameraMatrixIsRefusedOnlyWhenWorldNormalsNeedIt) {
+  const Camera cam;
+  Scene s = floor_and_wall(cam);
+  // Two parallel axes: world-space normals would be flattened into wrong ones.
+  const double singular[16] = {1, 1, 0, 0, 0, 0, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
+  for (const char* space : {"world", "camera"}) {
+    for (const bool with_normals : {true, false}) {
+      Job job;
+      job.camera(cam);
+      job.set("normal_space", space);
+      ASSERT_EQ(ssao_job_set_floats(job.get(), "camera_to_world", singular, 16), SSAO_OK);
+      std::vector<float> ao(s.depth.size(), -1.0f);
+      job.image("depth", s.depth, s.width, s.height, 1);
+      if (with_normals) job.image("normal", s.normal, s.width, s.height, 3);
+      job.image("ao", ao, s.width, s.height, 1);
+      const bool needed = with_normals && std::string(space) == "world";
+      EXPECT_EQ(job.run(), needed ? SSAO_ERROR_INVALID_ARGUMENT : SSAO_OK) << space;
+      if (needed) {
+        EXPECT_NE(std::string(ssao_last_error()).find("singular"), std::string::npos);
+        EXPECT_EQ(ao, std::vector<float>(s.depth.size(), -1.0f)) << "outputs touched";
+      }
+    }
+  }
+  // A scaled camera (scale 1e-3) is not singular.
+  const double scaled[16] = {1e-3, 0, 0, 0, 0, 1e-3, 0, 0, 0, 0, 1e-3, 0, 0, 0, 0, 1};
+  const auto view = compute_ao(s, cam, 1.0, "hemisphere");
+  const auto world = compute_ao(s, cam, 1.0, "hemisphere", true, [&](Job& j) {
+    j.set("normal_space", "world");
+    EXPECT_EQ(ssao_job_set_floats(j.get(), "camera_to_world", scaled, 16), SSAO_OK);
+  });
+  for (size_t i = 0; i < view.size(); ++i) EXPECT_NEAR(world[i], view[i], 1e-5f);
 }

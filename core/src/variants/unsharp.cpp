@@ -48,8 +48,12 @@ class Unsharp final : public Variant {
     // it stays centred on the pixel (a linear depth ramp then averages to its centre).
     const float reach_u = radius_ / f.camera().pixel_footprint(depth);
     const float reach_v = reach_u / f.camera().pixel_aspect();
-    const int half_u = std::min({int(reach_u + 0.5f), x, width_ - 1 - x});
-    const int half_v = std::min({int(reach_v + 0.5f), y, height_ - 1 - y});
+    // Capped at the image's size before the conversion to int: a tiny depth (a denormal one
+    // gives infinity) or a huge radius puts the reach beyond int's range, where the conversion
+    // is undefined. The cap changes no result: the box is clipped to the image anyway.
+    const int half_u = std::min({int(std::min(reach_u, float(width_)) + 0.5f), x, width_ - 1 - x});
+    const int half_v =
+        std::min({int(std::min(reach_v, float(height_)) + 0.5f), y, height_ - 1 - y});
     if (half_u < 1 && half_v < 1) return 1.0f;
     const int x0 = x - half_u, x1 = x + half_u + 1, y0 = y - half_v, y1 = y + half_v + 1;
     const int32_t count = box(count_sum_, x0, y0, x1, y1);

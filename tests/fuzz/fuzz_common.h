@@ -1,0 +1,46 @@
+// SPDX-License-Identifier: MIT
+// Shared by the fuzz targets that feed files: a private scratch folder per process (libFuzzer's
+// -jobs and -fork run several), removed at exit, and writing the input into it.
+#pragma once
+
+#include <cstdint>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+namespace fuzz {
+
+inline const std::filesystem::path& scratch_folder() {
+  // Never destroyed: the exit handler that removes the folder runs after static destructors.
+  static const std::filesystem::path* const folder = [] {
+    std::string pattern = (std::filesystem::temp_directory_path() / "ssao-fuzz-XXXXXX").string();
+    if (::mkdtemp(pattern.data()) == nullptr) {
+      std::perror("mkdtemp");
+      std::abort();
+    }
+    return new std::filesystem::path(pattern);
+  }();
+  static const int registered = std::atexit([] {
+    std::error_code ec;
+    std::filesystem::remove_all(*folder, ec);
+  });
+  (void)registered;
+  return *folder;
+}
+
+// Writes the input to `name` in the scratch folder and returns its path.
+inline std::string write_input(const char* name, const uint8_t* data, size_t size) {
+  const std::string path = (scratch_folder() / name).string();
+  std::ofstream file(path, std::ios::binary | std::ios::trunc);
+  file.write(reinterpret_cast<const char*>(data), static_cast<std::streamsize>(size));
+  file.close();
+  if (!file) {
+    std::fprintf(stderr, "cannot write %s\n", path.c_str());
+    std::abort();
+  }
+  return path;
+}
+
+}  // namespace fuzz

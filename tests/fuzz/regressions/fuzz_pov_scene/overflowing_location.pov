@@ -1,0 +1,1 @@
+camera { location <1e308*10,0,-5> }

@@ -1,0 +1,3 @@
+#declare C = camera { location <0,0,-5> look_at 0 }
+#declare C = camera { C }
+camera { C }
