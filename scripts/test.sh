@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # SPDX-License-Identifier: MIT
 # Quick start, step 2 (and CI): installs what is missing, builds, and runs every test: the
-# release build (every label), then the unit, cli and povray tests again in an
+# release build (every label), then the unit, stress, cli and povray tests again in an
 # AddressSanitizer + UndefinedBehaviorSanitizer build; the C API and concurrency tests in a
 # ThreadSanitizer build (build-tsan); and about a minute of fuzzing (scripts/fuzz.sh,
 # build-fuzz), which first replays every committed regression input.
@@ -21,7 +21,7 @@ echo "== sanitizer tests"
 # Python test helpers would need the sanitizer runtime preloaded; the C++ tests and the CLI are
 # what the sanitizers are for.
 ASAN_OPTIONS=detect_leaks=1:abort_on_error=0 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
-  ctest --test-dir "$root/build-asan" -L "unit|cli|povray" --output-on-failure -j"$jobs" || status=1
+  ctest --test-dir "$root/build-asan" -L "unit|stress|cli|povray" --output-on-failure -j"$jobs" || status=1
 echo "== ThreadSanitizer build and tests"
 # Only what runs under it: the C API tests and several jobs on several threads at once
 # (tests/unit/test_concurrency.cpp). tests/tsan.supp says why oneTBB's internals are suppressed;

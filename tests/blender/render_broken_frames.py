@@ -55,6 +55,7 @@ CASES = {
     # Blender keeps NaN in a float property (it clamps only numbers out of range).
     "radius nan": lambda: setattr(node, "radius", float("nan")),
     "normal pass off": lambda: setattr(layer, "use_pass_normal", False),
+    "depth pass off": lambda: setattr(layer, "use_pass_z", False),
 }
 
 

@@ -320,11 +320,11 @@ class AddonTest(unittest.TestCase):
         log = self.blender.run_ui(blend, os.path.join(HERE, "ui_render_animation.py"),
                                   "--fail-frame", "4", env=env)
         self.assertRegex(log, r"ui_render_animation \[ *[0-9.]+s\] done")
+        *ui_aos, failed_ao = self.assert_frames_are_beauty_times_ao(folder, 4)
+        np.testing.assert_array_equal(failed_ao, 1.0)
         self.assertEqual(log.count("with AO"), 3, log)
         self.assertRegex(log, r"error: Scene frame 4 node '[^']+': written WITHOUT AO: "
                               r"ssao_job_run: simulated library failure")
-        *ui_aos, failed_ao = self.assert_frames_are_beauty_times_ao(folder, 4)
-        np.testing.assert_array_equal(failed_ao, 1.0)
         headless = self.folder("ui_anim/headless")
         self.blender.run(blend, "-o", os.path.join(headless, "out_####"), "-e", "3", "-a", env={
             "SSAO_COMPOSITOR_EXPORT_DIR": os.path.join(headless, "export")})
@@ -448,8 +448,9 @@ class AddonTest(unittest.TestCase):
                   5: ("library fails", "simulated library failure"),
                   6: ("no depth", "the Depth input carries no depth"),
                   8: ("radius nan", "the node's property 'radius' is nan"),
-                  9: ("normal pass off", "Passes > Data > Normal")}
-        blend = self.blender.build_scene("broken/scene", "--frames", "9",
+                  9: ("normal pass off", "Passes > Data > Normal"),
+                  10: ("depth pass off", "Passes > Data > Z")}
+        blend = self.blender.build_scene("broken/scene", "--frames", "10",
                                          "--output", os.path.join(folder, "out_####.exr"),
                                          "--passes-dir", os.path.join(folder, "passes"))
         report_path = os.path.join(folder, "report.json")
@@ -459,7 +460,7 @@ class AddonTest(unittest.TestCase):
                                 frame=None)
         with open(report_path) as f:
             report = json.load(f)
-        for frame in range(1, 10):
+        for frame in range(1, 11):
             with self.subTest(frame=frame, case=breaks.get(frame, ("as saved",))[0]):
                 ao, _ = self.assert_composite_is_beauty_times_ao(
                     os.path.join(folder, f"out_{frame:04d}.exr"),

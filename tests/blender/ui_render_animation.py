@@ -49,8 +49,10 @@ def break_frame(frame):
     scene = bpy.context.scene
     width, height = scene.render.resolution_x, scene.render.resolution_y
     for node in compute.ssao_nodes(scene):
-        inner_tree.ao_image(node, width, height).pixels.foreach_set(
-            [0.5] * (width * height * 4))
+        image = inner_tree.ao_image(node, width, height)
+        image.pixels.foreach_set([0.5] * (width * height * 4))
+        image.update()  # as the add-on sets an AO (compute.py)
+        image.update_tag()
     run = native.Job.run
 
     def failing_run(self, progress=None):

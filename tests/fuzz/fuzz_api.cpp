@@ -149,10 +149,9 @@ void set_random_parameter(FuzzedDataProvider& in, ssao_job job) {
   if (how == 0) {  // an unknown name, or a known name through the wrong setter
     // (Cut at a NUL, as the library sees it.)
     const std::string name = (in.ConsumeBool() ? in.ConsumeRandomLengthString(12) : d.name).c_str();
-    const bool known =
-        std::any_of(table.begin(), table.end(), [&](const ssao_param_desc& p) {
-          return name == p.name && p.type == SSAO_PARAM_FLOAT;
-        });
+    const bool known = std::any_of(table.begin(), table.end(), [&](const ssao_param_desc& p) {
+      return name == p.name && p.type == SSAO_PARAM_FLOAT;
+    });
     const ssao_status s = ssao_job_set_float(job, name.c_str(), 0.5);
     if (!known) check(s == SSAO_ERROR_INVALID_ARGUMENT, "unknown/wrong-type name accepted");
     if (s != SSAO_OK) check(std::strlen(ssao_last_error()) > 0, "error without a message");
@@ -274,7 +273,7 @@ struct Buffer {
   std::vector<float> storage;  // whole rows, padding included
   float* top = nullptr;        // the top row (the last row in memory when bottom-up)
   int width = 0, height = 0, channels = 0;
-  std::ptrdiff_t pixel_stride = 0, row_stride = 0;  // resolved byte strides
+  std::ptrdiff_t pixel_stride = 0, row_stride = 0;              // resolved byte strides
   std::ptrdiff_t given_pixel_stride = 0, given_row_stride = 0;  // what set_image gets (0: packed)
 
   float* at(int x, int y, int c) {
@@ -312,8 +311,10 @@ Buffer make_buffer(FuzzedDataProvider& in, int width, int height, int channels) 
   b.width = width;
   b.height = height;
   b.channels = channels;
-  const int pixel_padding = in.ConsumeIntegralInRange<int>(0, 7) < 5 ? 0 : in.ConsumeIntegralInRange<int>(1, 2);
-  const int row_padding = in.ConsumeIntegralInRange<int>(0, 7) < 5 ? 0 : in.ConsumeIntegralInRange<int>(1, 3);
+  const int pixel_padding =
+      in.ConsumeIntegralInRange<int>(0, 7) < 5 ? 0 : in.ConsumeIntegralInRange<int>(1, 2);
+  const int row_padding =
+      in.ConsumeIntegralInRange<int>(0, 7) < 5 ? 0 : in.ConsumeIntegralInRange<int>(1, 3);
   const bool bottom_up = in.ConsumeIntegralInRange<int>(0, 3) == 0;
   b.pixel_stride = std::ptrdiff_t(channels + pixel_padding) * 4;
   const std::ptrdiff_t row_bytes = b.pixel_stride * width + row_padding * 4;
@@ -376,8 +377,8 @@ void fill(FuzzedDataProvider& in, Filler& f, Buffer& b, Kind kind) {
         if (f.mode == 1) {
           v = bits_to_float(uint32_t(f.next()));
         } else if (kind == Kind::depth) {
-          const bool in_box = x >= box_x && x < box_x + box_size && y >= box_y &&
-                              y < box_y + box_size;
+          const bool in_box =
+              x >= box_x && x < box_x + box_size && y >= box_y && y < box_y + box_size;
           const double d = f.scale * (1.0 + 0.02 * (tilt_x * float(x) + tilt_y * float(y))) *
                            (in_box ? 0.7 : 1.0);
           // Some sky at the top; depths past the float range are infinite (a double to float
@@ -406,8 +407,8 @@ void fill(FuzzedDataProvider& in, Filler& f, Buffer& b, Kind kind) {
 // An accepted view is detached at once (its memory does not exist).
 void hostile_set_image(FuzzedDataProvider& in, ssao_job job, const char* name) {
   static float dummy[4];
-  float* data = in.ConsumeBool() ? dummy
-                                 : reinterpret_cast<float*>(reinterpret_cast<char*>(dummy) + 1);
+  float* data =
+      in.ConsumeBool() ? dummy : reinterpret_cast<float*>(reinterpret_cast<char*>(dummy) + 1);
   const int width = in.ConsumeIntegral<int>(), height = in.ConsumeIntegral<int>();
   const int channels = in.ConsumeIntegralInRange<int>(-1, 6);
   const std::ptrdiff_t pixel_stride = in.ConsumeIntegral<std::ptrdiff_t>();
@@ -515,14 +516,14 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     wrong = make_buffer(in, wrong_size ? width + 1 : width, height, channels);
     attached[slot] = &wrong;
   }
-  const bool mismatch = attached[1] == &wrong || attached[2] == &wrong ||
-                        attached[3] == &wrong || attached[4] == &wrong || attached[5] == &wrong;
+  const bool mismatch = attached[1] == &wrong || attached[2] == &wrong || attached[3] == &wrong ||
+                        attached[4] == &wrong || attached[5] == &wrong;
   for (int i = 0; i < 6; ++i) {
     Buffer* b = attached[i];
     if (b == nullptr) continue;
-    const ssao_status s = ssao_job_set_image(job, kImageNames[i], b->top, b->width, b->height,
-                                             b->channels, b->given_pixel_stride,
-                                             b->given_row_stride);
+    const ssao_status s =
+        ssao_job_set_image(job, kImageNames[i], b->top, b->width, b->height, b->channels,
+                           b->given_pixel_stride, b->given_row_stride);
     check(s == SSAO_OK, std::string("valid image '") + kImageNames[i] + "' refused");
   }
 
@@ -557,7 +558,8 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
 
   Buffer* const out_ao = attached[4];
   Buffer* const out_composite = attached[5];
-  const bool has_inputs = with_depth && (out_ao || out_composite) && (!out_composite || with_beauty);
+  const bool has_inputs =
+      with_depth && (out_ao || out_composite) && (!out_composite || with_beauty);
   if (!has_inputs) {
     // (The sizes are compared before the composite asks for its beauty.)
     check(status == SSAO_ERROR_INVALID_OPERATION ||
@@ -567,8 +569,8 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     check(status == SSAO_ERROR_INVALID_ARGUMENT, "an image of another size was not refused");
   } else if (!mismatch && !log.cancelled) {
     const std::string message = ssao_last_error();
-    check(status == SSAO_OK ||
-              (status == SSAO_ERROR_INVALID_ARGUMENT && message.find("camera") != std::string::npos),
+    check(status == SSAO_OK || (status == SSAO_ERROR_INVALID_ARGUMENT &&
+                                message.find("camera") != std::string::npos),
           "a valid run was refused");
   }
 

@@ -15,11 +15,10 @@ int main() {
   ssao::Progress progress(nullptr, nullptr);
   int shared = 0;  // written by every tile without synchronisation: the race
   // 64 tiles that take a moment each, so that both threads run some.
-  pool.for_each_tile(8 * ssao::kTileWidth, 8 * ssao::kTileHeight, progress,
-                     [&](const ssao::Tile&) {
-                       std::this_thread::sleep_for(std::chrono::milliseconds(2));
-                       shared = shared + 1;
-                     });
+  pool.for_each_tile(8 * ssao::kTileWidth, 8 * ssao::kTileHeight, progress, [&](const ssao::Tile&) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(2));
+    shared = shared + 1;
+  });
   std::printf("tsan canary: %d tiles counted\n", shared);
   return 0;
 }
