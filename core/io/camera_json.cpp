@@ -7,6 +7,7 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <sstream>
+#include <utility>
 
 #include "io/job.h"
 
@@ -47,12 +48,11 @@ class Reader {
 
   // A key the projection depends on: absent is an error, never a default (a default would
   // give a plausible but wrong image). `what` says what the key is, for the message.
-  void required_number(const char* key, double& out, const char* what) const {
+  void require(const char* key, const char* what) const {
     if (!root_.contains(key)) {
       throw Error("camera file '" + source_ + "': missing key '" + key + "' (" + what +
                   "); scripts/blender/export_cameras.py writes every key");
     }
-    number(key, out);
   }
 
   void positive(const char* key, double value) const {
@@ -147,29 +147,12 @@ Camera parse_camera_json(const std::string& text, const std::string& source) {
   const Reader read(root, source);
   read.choice("type", camera.type, {"PERSP", "ORTHO"}, true);
   read.choice("sensor_fit", camera.sensor_fit, {"AUTO", "HORIZONTAL", "VERTICAL"}, true);
-  const bool perspective = camera.type == "PERSP";
-  // Only the keys this camera's projection reads are required (Blender's own rule: AUTO and
-  // HORIZONTAL fit sensor_width, VERTICAL fits sensor_height; ORTHO reads ortho_scale instead).
-  if (perspective) {
-    read.required_number("lens", camera.lens, "the focal length in mm");
-    if (camera.sensor_fit == "VERTICAL") {
-      read.required_number("sensor_height", camera.sensor_height,
-                           "the sensor height in mm, which a VERTICAL fit uses");
-      read.number("sensor_width", camera.sensor_width);
-    } else {
-      read.required_number("sensor_width", camera.sensor_width, "the sensor width in mm");
-      read.number("sensor_height", camera.sensor_height);
-    }
-    read.number("ortho_scale", camera.ortho_scale);
-  } else {
-    read.required_number("ortho_scale", camera.ortho_scale,
-                         "the view's width in scene units, which an ORTHO camera needs");
-    read.number("lens", camera.lens);
-    read.number("sensor_width", camera.sensor_width);
-    read.number("sensor_height", camera.sensor_height);
-  }
-  read.required_number("shift_x", camera.shift_x, "the horizontal lens shift; 0 for none");
-  read.required_number("shift_y", camera.shift_y, "the vertical lens shift; 0 for none");
+  read.number("lens", camera.lens);
+  read.number("sensor_width", camera.sensor_width);
+  read.number("sensor_height", camera.sensor_height);
+  read.number("shift_x", camera.shift_x);
+  read.number("shift_y", camera.shift_y);
+  read.number("ortho_scale", camera.ortho_scale);
   read.number("clip_start", camera.clip_start);
   read.number("clip_end", camera.clip_end);
   read.number("pixel_aspect_x", camera.pixel_aspect_x);
@@ -177,12 +160,29 @@ Camera parse_camera_json(const std::string& text, const std::string& source) {
   read.matrix("matrix_world", camera.matrix_world);
   camera.has_matrix_world = root.contains("matrix_world");
   read.number("ao_distance", camera.ao_distance);
-  for (const char* key : {"lens", "sensor_width", "sensor_height", "ortho_scale", "clip_end",
-                          "pixel_aspect_x", "pixel_aspect_y", "ao_distance"}) {
-    double value = 0.0;
-    read.number(key, value);
-    read.positive(key, value);
+  // Only the keys this camera's projection reads are required (Blender's own rule: AUTO and
+  // HORIZONTAL fit sensor_width, VERTICAL fits sensor_height; ORTHO reads ortho_scale instead).
+  if (camera.type == "PERSP") {
+    read.require("lens", "the focal length in mm");
+    if (camera.sensor_fit == "VERTICAL") {
+      read.require("sensor_height", "the sensor height in mm, which a VERTICAL fit uses");
+    } else {
+      read.require("sensor_width", "the sensor width in mm");
+    }
+  } else {
+    read.require("ortho_scale", "the view's width in scene units, which an ORTHO camera needs");
   }
+  read.require("shift_x", "the horizontal lens shift; 0 for none");
+  read.require("shift_y", "the vertical lens shift; 0 for none");
+  const std::pair<const char*, double> sizes[] = {{"lens", camera.lens},
+                                                  {"sensor_width", camera.sensor_width},
+                                                  {"sensor_height", camera.sensor_height},
+                                                  {"ortho_scale", camera.ortho_scale},
+                                                  {"clip_end", camera.clip_end},
+                                                  {"pixel_aspect_x", camera.pixel_aspect_x},
+                                                  {"pixel_aspect_y", camera.pixel_aspect_y},
+                                                  {"ao_distance", camera.ao_distance}};
+  for (const auto& [key, value] : sizes) read.positive(key, value);
   read.not_negative("clip_start", camera.clip_start);
 
   for (const auto& item : root.items()) {
