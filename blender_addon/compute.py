@@ -271,8 +271,7 @@ def compute_node(node, scene, passes):
     with ssao_native.Job(library()) as job:
         for name, value in camera.items():
             job.set(name, value)
-        if compat.is_eevee(scene):
-            job.set("background_depth", EEVEE_BACKGROUND_DEPTH)
+        job.set("background_depth", background)  # the same as the Normal check's
         job.set("threads", threads(scene))
         for name, value in node_parameters(node).items():
             job.set(name, value)
