@@ -9,17 +9,13 @@
 #include <cstdlib>
 #include <string>
 
+#include "fuzz_common.h"
 #include "io/camera_json.h"
 #include "io/job.h"
 
 namespace {
 
-void check(bool ok, const char* what) {
-  if (!ok) {
-    std::fprintf(stderr, "fuzz_camera_json: %s\n", what);
-    std::abort();
-  }
-}
+using fuzz::check;
 
 }  // namespace
 

@@ -1,8 +1,10 @@
 // SPDX-License-Identifier: MIT
-// Shared by the fuzz targets that feed files: a private scratch folder per process (libFuzzer's
-// -jobs and -fork run several), removed at exit, and writing the input into it.
+// Shared by the fuzz targets: check(), and for those that feed files, a private scratch folder
+// per process (libFuzzer's -jobs and -fork run several), removed at exit, and writing the input
+// into it.
 #pragma once
 
+#include <cerrno>  // program_invocation_short_name (glibc)
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
@@ -11,6 +13,14 @@
 #include <string>
 
 namespace fuzz {
+
+// A property the target asserts: when it does not hold, says which (after the target's name)
+// and aborts, which libFuzzer reports as a crash and keeps the input of.
+inline void check(bool ok, const char* what) {
+  if (ok) return;
+  std::fprintf(stderr, "%s: %s\n", program_invocation_short_name, what);
+  std::abort();
+}
 
 inline const std::filesystem::path& scratch_folder() {
   // Never destroyed: the exit handler that removes the folder runs after static destructors.

@@ -38,12 +38,7 @@
 
 namespace {
 
-void check(bool ok, const char* what) {
-  if (!ok) {
-    std::fprintf(stderr, "fuzz_exr: %s\n", what);
-    std::abort();
-  }
-}
+using fuzz::check;
 
 std::vector<int> indices_of(const ssao_io::Image& image, const std::vector<std::string>& names,
                             const std::string& path) {

@@ -21,12 +21,7 @@
 
 namespace {
 
-void check(bool ok, const char* what) {
-  if (!ok) {
-    std::fprintf(stderr, "fuzz_pov_scene: %s\n", what);
-    std::abort();
-  }
-}
+using fuzz::check;
 
 bool finite(povray_ssao::V3 v) {
   return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
