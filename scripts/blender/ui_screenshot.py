@@ -226,11 +226,14 @@ def split_for_image_editor(window):
     new = [a for a in window.screen.areas if a.as_pointer() not in before]
     if not new:
         raise RuntimeError("area_split made no area")
-    # The new area has x = width = 0 until the next redraw: wait for it, then the image goes
-    # to the one on the right (sorting at once put the image on the left in 5.2).
+    # Its final type at once, before any redraw: Blender 3.4 sets up the split-off copy of
+    # the Node Editor only when it first draws it, and a scene/nodes notifier that reaches
+    # the copy before then crashes Blender (a NULL write in the node editor's listener; every
+    # run with an empty shader cache, whose first draw takes seconds). A vertical split puts
+    # the new area on the right (3.4, 4.3, 5.2); its x and width are 0 until the next redraw.
+    new[0].ui_type = 'IMAGE_EDITOR'
     yield 0.5
-    pair = sorted([area, new[0]], key=lambda a: a.x)
-    pair[1].ui_type = 'IMAGE_EDITOR'
+    REPORT["image_editor_on_the_right"] = new[0].x > area.x
 
 
 def show_render_result(window):
