@@ -8,7 +8,8 @@ and in the manifest is the project's (CMakeLists.txt), written in when the zip i
 Modules: node (the node type), inner_tree (its built-in inner nodes), compute (libssao),
 ssao_native (the ctypes binding), recomposite (running the compositor again), multilayer (EXR
 layers), saved_form (how a .blend carries the node), handlers (render and file events),
-operators, preferences, camera, compat (every Blender-version difference)."""
+main_thread (render-thread handlers' work done on the main thread), operators, preferences,
+camera, compat (every Blender-version difference)."""
 
 bl_info = {
     "name": "Ambient Occlusion (SSAO) compositor node",

@@ -7,11 +7,12 @@ inner_tree.py). Then:
     Result's passes and re-runs only the compositor (recomposite.py); render_write writes that
     result over the frame's output file (a multilayer EXR gets every pass, the new Composite and
     the AO);
-  - in the UI, handlers run in the render thread: render_write (an animation, Ctrl+F12) saves
-    each written frame's passes, render_post records the frame; when the render job is over, a
-    main-thread timer re-composites and rewrites every written frame with its own AO, then
-    computes the current frame's AO and nudges the UI compositor, which re-composites the
-    Render Result on screen.
+  - in the UI, handlers run in the render thread and touch no Blender data there (a deadlock,
+    see main_thread.py): render_write (an animation, Ctrl+F12) has the main thread save each
+    written frame's passes while it waits, render_post records the frame; when the render job
+    is over, a main-thread timer re-composites and rewrites every written frame with its own
+    AO, then computes the current frame's AO and nudges the UI compositor, which re-composites
+    the Render Result on screen.
 Changing a node property recomputes from the exported passes, without rendering.
 (Measured facts behind this design: docs/blender.md.)"""
 import atexit
@@ -22,7 +23,7 @@ import time
 
 import bpy
 
-from . import compat, compute, inner_tree, recomposite, saved_form
+from . import compat, compute, inner_tree, main_thread, recomposite, saved_form
 from .compute import report
 
 _pending_frames = []    # UI: (scene name, frame) rendered, waiting for the main-thread timer
@@ -44,14 +45,14 @@ def _computed(aos):
     return any(ao is not None for ao in aos.values())
 
 
-def _written_output(scene):
-    """The file Blender just wrote for this frame: the frame path (-f, -a) or, for a still
-    written from a script (render(write_still=True)), the output path without frame number."""
+def _written_output(scene, frame):
+    """The file Blender just wrote for `frame`: the frame path (-f, -a) or, for a still written
+    from a script (render(write_still=True)), the output path without frame number."""
     render = scene.render
     still = bpy.path.abspath(render.filepath)
     if render.use_file_extension and not still.lower().endswith(render.file_extension.lower()):
         still += render.file_extension
-    candidates = [p for p in (render.frame_path(frame=scene.frame_current), still)
+    candidates = [p for p in (render.frame_path(frame=frame), still)
                   if os.path.isfile(p)]
     return max(candidates, key=os.path.getmtime) if candidates else None
 
@@ -102,10 +103,13 @@ def _on_render_pre(scene, *_):
 
 @bpy.app.handlers.persistent
 def _on_render_post(scene, *_):
-    if recomposite.is_running() or not compute.ssao_nodes(scene):
+    if recomposite.is_running():
         return
     if not bpy.app.background:
-        _pending_frames.append((scene.name, scene.frame_current))  # for _process_pending
+        # The render thread: only record (_finish_rendered_frames skips scenes without nodes).
+        _pending_frames.append((scene.name, scene.frame_current))
+        return
+    if not compute.ssao_nodes(scene):
         return
     frame = scene.frame_current
     if compat.is_movie(scene.render.image_settings):
@@ -135,25 +139,20 @@ def _on_render_write(scene, *_):
     frame = scene.frame_current
     if not bpy.app.background:
         # An animation in the UI: the Render Result holds this frame's passes only until the
-        # next frame renders, so save them now (render thread) and finish after the job.
-        if compat.is_movie(scene.render.image_settings):
-            _warn_movie_once(scene)
-        elif compute.ssao_nodes(scene):
-            output = _written_output(scene)
-            passes = recomposite.passes_path(scene, frame)
-            try:
-                recomposite.save_passes(scene, passes)
-                _written_frames.append((scene.name, frame, output, passes))
-            except Exception as error:
-                report(f"frame {frame}: saving the passes failed, the file keeps the AO of "
-                       f"before: {error}", error=True)
+        # next frame renders. This thread (the render thread) waits while the main thread saves
+        # them; the rest is done after the job.
+        try:
+            main_thread.call(_save_written_frame, scene.name, frame)
+        except Exception as error:
+            report(f"{scene.name} frame {frame}: saving the passes failed, the file keeps the AO "
+                   f"of the frame before: {error}", error=True)
         return
     entry = _recomposited.pop((scene.name, frame), None)
     if entry is None:
         return
     passes, layers = entry
     try:
-        output = _written_output(scene)
+        output = _written_output(scene, frame)
         if output is None:
             report(f"{scene.name} frame {frame}: cannot find the file this render wrote; it "
                    "keeps the composite WITHOUT AO", error=True)
@@ -168,16 +167,36 @@ def _on_render_write(scene, *_):
         _remove(passes)
 
 
+def _save_written_frame(scene_name, frame):
+    """UI, main thread, while the render thread waits in render_write: saves the passes of the
+    frame just written, for _finish_rendered_frames."""
+    scene = bpy.data.scenes.get(scene_name)
+    if scene is None:
+        return
+    if compat.is_movie(scene.render.image_settings):
+        _warn_movie_once(scene)
+        return
+    if not compute.ssao_nodes(scene):
+        return
+    passes = recomposite.passes_path(scene, frame)
+    recomposite.save_passes(scene, passes)
+    _written_frames.append((scene.name, frame, _written_output(scene, frame), passes))
+
+
 def _process_pending():
-    """UI: main-thread work after a render (handlers run in the render thread there, where no
-    timer may be registered: this one polls, from register() on, and must never raise, or
-    Blender drops it)."""
+    """UI: the main thread's share of a render (handlers run in the render thread there, where
+    no timer may be registered): the work render handlers ask for while they wait, then, after
+    the job, every frame's AO. This timer polls from register() on (often during a render: the
+    render thread waits on it) and must never raise, or Blender drops it."""
+    rendering = False
     try:
-        if not bpy.app.is_job_running('RENDER') and (_written_frames or _pending_frames):
+        main_thread.serve()
+        rendering = bpy.app.is_job_running('RENDER')
+        if not rendering and (_written_frames or _pending_frames):
             _finish_rendered_frames()
     except Exception as error:
         report(f"after the render: {error}", error=True)
-    return 0.2
+    return 0.05 if rendering else 0.2
 
 
 def _finish_rendered_frames():
@@ -210,7 +229,7 @@ def _finish_rendered_frames():
     last = _pending_frames[-1] if _pending_frames else None
     _pending_frames.clear()
     scene = bpy.data.scenes.get(last[0]) if last else None
-    if scene is None:
+    if scene is None or not compute.ssao_nodes(scene):
         return
     # The Render Result shows the last frame rendered; after an animation the scene is back
     # at its own frame: that frame's camera for the AO, then the scene as it was.
@@ -361,6 +380,7 @@ def register():
     # This session's exports are of no use to any other: remove them when Blender quits.
     atexit.register(shutil.rmtree, compute.PROCESS_EXPORT_DIR, ignore_errors=True)
     if not bpy.app.background:
+        main_thread.start()
         bpy.app.timers.register(_process_pending, first_interval=0.2, persistent=True)
     # Nodes of a file that is already open (enabling the add-on after loading).
     try:
@@ -370,6 +390,7 @@ def register():
 
 
 def unregister():
+    main_thread.stop()  # a render thread waiting for the timer goes on without its work
     for timer in (_process_pending, _check_nudge):
         if bpy.app.timers.is_registered(timer):
             bpy.app.timers.unregister(timer)

@@ -28,6 +28,8 @@ sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."
 from image_files import read_image  # noqa: E402
 
 HERE = os.path.dirname(os.path.abspath(__file__))
+# Frames of test_ui_animation_of_many_frames_does_not_hang (docs/testing.md: what it detects).
+UI_STRESS_FRAMES = int(os.environ.get("SSAO_UI_STRESS_FRAMES", "100"))
 BUILD_SCENE = os.path.join(HERE, "build_ssao_scene.py")
 CONFIG = {}
 
@@ -371,6 +373,32 @@ class AddonTest(unittest.TestCase):
             ui_out = rgb(read_exr(os.path.join(folder, f"out_{frame:04d}.exr")))
             np.testing.assert_allclose(ui_out, out, atol=1e-4, err_msg=f"frame {frame}")
         self.assertGreater(float(np.abs(ui_aos[0] - ui_aos[2]).max()), 0.1, "the camera moves")
+
+    @unittest.skipUnless(shutil.which("xvfb-run"), "needs xvfb-run (apt-get install xvfb)")
+    def test_ui_animation_of_many_frames_does_not_hang(self):
+        # Ctrl+F12 with Blender's render window drawing every frame as it renders (issue 20):
+        # saving a frame's passes from the render thread deadlocked Blender 5.2 against the
+        # render window's drawing in about 1 animation render in 10. UI_STRESS_FRAMES frames in
+        # one run; a hang fails the test (run_ui: stacks dumped, no retry). Every frame must
+        # be written with its own AO.
+        frames = UI_STRESS_FRAMES
+        folder = self.folder("ui_many")
+        blend = self.blender.build_scene("ui_many/scene", "--frames", str(frames),
+                                         "--samples", "4",
+                                         "--output", os.path.join(folder, "out_####.exr"),
+                                         "--passes-dir", os.path.join(folder, "passes"))
+        env = {"SSAO_COMPOSITOR_EXPORT_DIR": os.path.join(folder, "export")}
+        log = self.blender.run_ui(blend, os.path.join(HERE, "ui_render_animation.py"),
+                                  "--timeout", str(60 + 2 * frames), env=env,
+                                  timeout=120 + 2 * frames)  # 0.3-0.8 s a frame measured
+        self.assertRegex(log, r"ui_render_animation \[ *[0-9.]+s\] done")
+        self.assertEqual(log.count("with AO"), frames, log)
+        self.assertNotIn("saving the passes failed", log)
+        aos = self.assert_frames_are_beauty_times_ao(folder, frames)
+        self.assertGreater(float(np.abs(aos[0] - aos[-1]).max()), 0.1, "the camera moves")
+        done = re.search(r"ui_render_animation \[ *([0-9.]+)s\] done", log).group(1)
+        print(f"\n[measure] UI animation of {frames} frames: done after {done} s",
+              file=sys.stderr)
 
     def test_saved_file_composites_without_the_addon(self):
         folder = self.folder("reopen")

@@ -20,7 +20,8 @@ TIMEOUT = float(sys.argv[sys.argv.index("--timeout") + 1]) if "--timeout" in sys
 FAIL_FRAME = int(sys.argv[sys.argv.index("--fail-frame") + 1]) if "--fail-frame" in sys.argv \
     else None
 START = time.monotonic()
-STATE = {"started": False, "idle_since": None}
+STATE = {"started": False, "idle_since": None, "logged_frames": 0}
+WRITTEN = []  # frames Blender wrote (render_write, the render thread: only record)
 
 
 def log(message):
@@ -85,6 +86,9 @@ def step():
             STATE["started"] = True
             log("render job started (Ctrl+F12)")
             return 1.0
+        if len(WRITTEN) != STATE["logged_frames"]:  # a hang's log then says where it stopped
+            STATE["logged_frames"] = len(WRITTEN)
+            log(f"{len(WRITTEN)} frame(s) written, the last {WRITTEN[-1]}")
         if bpy.app.is_job_running('RENDER') or addon_busy():
             STATE["idle_since"] = None
             return 0.5
@@ -99,4 +103,10 @@ def step():
     return None
 
 
+@bpy.app.handlers.persistent
+def record_written(scene, *_):
+    WRITTEN.append(scene.frame_current)
+
+
+bpy.app.handlers.render_write.append(record_written)
 bpy.app.timers.register(step, first_interval=2.0)
