@@ -183,6 +183,46 @@ def _save_written_frame(scene_name, frame):
     _written_frames.append((scene.name, frame, _written_output(scene, frame), passes))
 
 
+# Blender keeps one process-wide "no data-block writes" flag, set around read-only Python
+# callbacks (panel drawing, some render-engine callbacks) and restored by each caller without
+# regard to other threads (Blender issue #127767): a render-thread callback can leave it set on
+# the main thread, and every later write from a timer then fails ("Writing to ID classes in this
+# context is not allowed"; seen once in 3.4.1 after 98 Ctrl+F12 frames, and all 100 frames
+# were then written without AO). Writes to the window manager are always allowed, and Blender
+# allows every write inside a Python property's update callback: the timers' work runs there.
+_WRITES_PROPERTY = "ssao_compositor_timer_tick"
+_with_writes = {"run": None}  # what the property's update callback runs
+
+
+def _run_with_writes(_window_manager, _context):
+    if _with_writes["run"] is not None:
+        _with_writes["run"]()
+
+
+def with_writes(function):
+    """function() where Blender allows data-block writes (see above); returns its result."""
+    outcome = {}
+
+    def run():
+        try:
+            outcome["result"] = function()
+        except Exception as error:  # raised again below, outside Blender's callback
+            outcome["error"] = error
+
+    previous, _with_writes["run"] = _with_writes["run"], run
+    try:
+        window_manager = bpy.context.window_manager
+        tick = getattr(window_manager, _WRITES_PROPERTY)
+        setattr(window_manager, _WRITES_PROPERTY, (tick + 1) % 1000000)
+    finally:
+        _with_writes["run"] = previous
+    if not outcome:  # no update callback (the property is gone): try as it is
+        run()
+    if "error" in outcome:
+        raise outcome["error"]
+    return outcome.get("result")
+
+
 def _process_pending():
     """UI: the main thread's share of a render (handlers run in the render thread there, where
     no timer may be registered): the work render handlers ask for while they wait, then, after
@@ -190,10 +230,13 @@ def _process_pending():
     render thread waits on it) and must never raise, or Blender drops it."""
     rendering = False
     try:
-        main_thread.serve()
+        if main_thread.pending():
+            with_writes(main_thread.serve)
+        else:
+            main_thread.serve()  # no work: only the render thread's sign of life
         rendering = bpy.app.is_job_running('RENDER')
         if not rendering and (_written_frames or _pending_frames):
-            _finish_rendered_frames()
+            with_writes(_finish_rendered_frames)
     except Exception as error:
         report(f"after the render: {error}", error=True)
     return 0.05 if rendering else 0.2
@@ -282,7 +325,7 @@ def _check_nudge():
         return None
     _nudge["tries"] += 1
     _nudge["composited"] = False
-    _nudge_nodes(scene)
+    with_writes(lambda: _nudge_nodes(scene))
     return 0.5
 
 
@@ -379,6 +422,8 @@ def register():
         getattr(bpy.app.handlers, name).append(handler)
     # This session's exports are of no use to any other: remove them when Blender quits.
     atexit.register(shutil.rmtree, compute.PROCESS_EXPORT_DIR, ignore_errors=True)
+    setattr(bpy.types.WindowManager, _WRITES_PROPERTY, bpy.props.IntProperty(
+        options={'HIDDEN', 'SKIP_SAVE'}, update=_run_with_writes))
     if not bpy.app.background:
         main_thread.start()
         bpy.app.timers.register(_process_pending, first_interval=0.2, persistent=True)
@@ -404,3 +449,5 @@ def unregister():
         handlers = getattr(bpy.app.handlers, name)
         if handler in handlers:
             handlers.remove(handler)
+    if hasattr(bpy.types.WindowManager, _WRITES_PROPERTY):
+        delattr(bpy.types.WindowManager, _WRITES_PROPERTY)

@@ -360,6 +360,9 @@ class AddonTest(unittest.TestCase):
         log = self.blender.run_ui(blend, os.path.join(HERE, "ui_render_animation.py"),
                                   "--fail-frame", "4", env=env)
         self.assertRegex(log, r"ui_render_animation \[ *[0-9.]+s\] done")
+        # The add-on's timers write where Blender refuses writes (handlers.with_writes).
+        self.assertIn("read-only draw: direct write refused: Writing to ID classes", log)
+        self.assertIn("read-only draw: with_writes wrote", log)
         *ui_aos, failed_ao = self.assert_frames_are_beauty_times_ao(folder, 4)
         np.testing.assert_array_equal(failed_ao, 1.0)
         self.assertEqual(log.count("with AO"), 3, log)

@@ -9,7 +9,11 @@ then quits. Run under Xvfb by tests/blender/test_addon.py:
 --fail-frame N: the SSAO nodes start with an AO of 0.5 (one left by an earlier render), and the
 library fails on frame N, whose file must then get no AO at all, not that one nor another
 frame's. Prints "ui_render_animation [...] done" when everything finished, and exits non-zero on
-a timeout or an exception."""
+a timeout or an exception.
+
+Also probes, from a panel's draw() (where Blender refuses data-block writes), whether the add-on's
+handlers.with_writes() can still write, and prints "read-only draw: direct write refused: ..."
+and "read-only draw: with_writes wrote: ..." (see handlers.py for why the timers need it)."""
 import sys
 import time
 import traceback
@@ -64,7 +68,44 @@ def break_frame(frame):
     native.Job.run = failing_run
 
 
+PROBE = {}
+
+
+class SSAO_TEST_PT_read_only_probe(bpy.types.Panel):
+    """Blender draws panels in a read-only context: writes to data-blocks raise there."""
+    bl_space_type = 'PROPERTIES'
+    bl_region_type = 'WINDOW'
+    bl_context = 'render'
+    bl_label = "SSAO read-only probe"
+
+    def draw(self, context):
+        if PROBE:
+            return
+        scene = bpy.data.scenes[0]
+        try:
+            scene.frame_preview_start = scene.frame_preview_start
+            PROBE["direct"] = "write allowed"
+        except Exception as error:
+            PROBE["direct"] = f"write refused: {error}"
+        try:
+            addon_module("handlers").with_writes(
+                lambda: setattr(scene, "frame_preview_start", scene.frame_preview_start))
+            PROBE["with_writes"] = "wrote"
+        except Exception as error:
+            PROBE["with_writes"] = f"failed: {error}"
+
+
+def show_render_properties():
+    for window in bpy.context.window_manager.windows:
+        for area in window.screen.areas:
+            if area.type == 'PROPERTIES':
+                area.spaces.active.context = 'RENDER'
+                area.tag_redraw()
+
+
 def quit_blender(code):
+    log(f"read-only draw: direct {PROBE.get('direct', 'not drawn')}")
+    log(f"read-only draw: with_writes {PROBE.get('with_writes', 'not drawn')}")
     log("done" if code == 0 else "failed")
     sys.stdout.flush()
     # os._exit skips Blender's own shutdown, which can hang under Xvfb; files are written.
@@ -78,6 +119,7 @@ def step():
             log(f"timeout after {TIMEOUT:.0f} s")
             quit_blender(1)
         if not STATE["started"]:
+            show_render_properties()
             if FAIL_FRAME is not None:
                 break_frame(FAIL_FRAME)
             window = bpy.context.window_manager.windows[0]
@@ -109,4 +151,5 @@ def record_written(scene, *_):
 
 
 bpy.app.handlers.render_write.append(record_written)
+bpy.utils.register_class(SSAO_TEST_PT_read_only_probe)
 bpy.app.timers.register(step, first_interval=2.0)
