@@ -167,6 +167,10 @@ SSAO_API ssao_status ssao_job_set_progress(ssao_job job, ssao_progress_fn fn, vo
   return guarded([&] { checked(job).set_progress(fn, user); });
 }
 
+SSAO_API ssao_status ssao_job_set_output_window(ssao_job job, int enable, int x, int y) {
+  return guarded([&] { checked(job).set_output_window(enable != 0, x, y); });
+}
+
 SSAO_API ssao_status ssao_job_auto_radius(ssao_job job, double* out) {
   return guarded([&] {
     if (out == nullptr) ssao::throw_invalid_argument("output pointer is NULL");

@@ -42,6 +42,14 @@ class CameraModel {
     return c;
   }
 
+  // The same camera on a larger image that holds this one's pixel (0, 0) at pixel (dx, dy)
+  // (a guard band on the same pixel grid).
+  CameraModel moved_by(int dx, int dy) const {
+    CameraModel c = *this;
+    c.center_u_ += float(dx), c.center_v_ += float(dy);
+    return c;
+  }
+
   bool orthographic() const { return orthographic_; }
   CameraIntrinsics intrinsics() const {
     return {orthographic_, scale_u_, scale_v_, center_u_, center_v_};

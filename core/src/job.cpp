@@ -98,11 +98,36 @@ constexpr size_t kAutoRadiusSamples = 1u << 20;
 
 }  // namespace
 
+void Job::set_output_window(bool enable, int x, int y) {
+  if (enable && (x < 0 || y < 0)) {
+    throw_invalid_argument("output window at (" + std::to_string(x) + ", " + std::to_string(y) +
+                           "): the window's top-left pixel must not be left of or above the "
+                           "depth image");
+  }
+  windowed_ = enable;
+  window_x_ = enable ? x : 0;
+  window_y_ = enable ? y : 0;
+}
+
+Tile Job::output_window() const {
+  const ImageView& out = ao_out_.attached() ? ao_out_ : composite_out_;
+  if (!windowed_ || !out.attached()) return {0, 0, depth_.width, depth_.height};
+  return {window_x_, window_y_, window_x_ + out.width, window_y_ + out.height};
+}
+
+CameraModel Job::input_camera() const {
+  const Tile w = output_window();
+  return CameraModel(camera_params(params_), std::max(w.x1 - w.x0, 1), std::max(w.y1 - w.y0, 1))
+      .moved_by(w.x0, w.y0);
+}
+
 double Job::auto_radius() const {
   if (!depth_.attached()) throw_invalid_operation("no depth image: attach one with set_image");
-  const int width = depth_.width, height = depth_.height;
+  // Over the output window (the frame as rendered): a guard band does not change the radius.
+  const Tile window = output_window();
+  const int width = window.x1 - window.x0, height = window.y1 - window.y0;
   const ParamValues& v = params_;
-  const CameraModel camera(camera_params(v), std::max(width, 1), std::max(height, 1));
+  const CameraModel camera = input_camera();
   const bool radial = v.get_string("depth_kind") == "radial";
   double limit = v.get_float("background_depth");
   if (v.get_float("clip_end") > 0.0) limit = std::min(limit, v.get_float("clip_end"));
@@ -111,7 +136,7 @@ double Job::auto_radius() const {
   std::vector<float> planar;
   planar.reserve(std::min(pixels, kAutoRadiusSamples + 1));
   for (size_t i = 0; i < pixels; i += step) {
-    const int x = int(i % size_t(width)), y = int(i / size_t(width));
+    const int x = window.x0 + int(i % size_t(width)), y = window.y0 + int(i / size_t(width));
     const float d = depth_.pixel(x, y)[0];
     if (!(std::isfinite(d) && d > 0.0f && double(d) < limit)) continue;
     // Radial depth over the length of the pixel's ray at planar depth 1.
@@ -200,17 +225,38 @@ void Job::validate_images() const {
   if (!ao_out_.attached() && !composite_out_.attached()) {
     throw_invalid_operation("no output image: attach 'ao' or 'composite'");
   }
-  const std::pair<const char*, const ImageView*> others[] = {{"normal", &normal_},
-                                                             {"beauty", &beauty_},
-                                                             {"ambient", &ambient_},
-                                                             {"ao", &ao_out_},
-                                                             {"composite", &composite_out_}};
-  for (const auto& [name, view] : others) {
+  const auto size = [](const ImageView& view) {
+    return std::to_string(view.width) + "x" + std::to_string(view.height);
+  };
+  // Input images have the depth image's size; the others, the output window's (the same
+  // without a window).
+  const std::pair<const char*, const ImageView*> inputs[] = {{"normal", &normal_}};
+  const std::pair<const char*, const ImageView*> outputs[] = {{"beauty", &beauty_},
+                                                              {"ambient", &ambient_},
+                                                              {"ao", &ao_out_},
+                                                              {"composite", &composite_out_}};
+  for (const auto& [name, view] : inputs) {
     if (view->attached() && (view->width != depth_.width || view->height != depth_.height)) {
-      throw_invalid_argument(std::string("image '") + name + "' is " + std::to_string(view->width) +
-                             "x" + std::to_string(view->height) + " but depth is " +
-                             std::to_string(depth_.width) + "x" + std::to_string(depth_.height));
+      throw_invalid_argument(std::string("image '") + name + "' is " + size(*view) +
+                             " but depth is " + size(depth_));
     }
+  }
+  const Tile window = output_window();
+  const int window_width = window.x1 - window.x0, window_height = window.y1 - window.y0;
+  for (const auto& [name, view] : outputs) {
+    if (!view->attached() || (view->width == window_width && view->height == window_height)) {
+      continue;
+    }
+    throw_invalid_argument(std::string("image '") + name + "' is " + size(*view) + " but " +
+                           (windowed_ ? "the output window is " + std::to_string(window_width) +
+                                            "x" + std::to_string(window_height)
+                                      : "depth is " + size(depth_)));
+  }
+  if (window.x1 > depth_.width || window.y1 > depth_.height) {
+    throw_invalid_argument("the output window " + std::to_string(window_width) + "x" +
+                           std::to_string(window_height) + " at (" + std::to_string(window.x0) +
+                           ", " + std::to_string(window.y0) + ") does not fit in the " +
+                           size(depth_) + " depth image");
   }
   if (composite_out_.attached()) {
     if (!beauty_.attached()) throw_invalid_operation("'composite' output needs a 'beauty' image");
@@ -235,10 +281,11 @@ TilePool& Job::pool(int threads) {
 void Job::run() {
   validate_images();
   const int width = depth_.width, height = depth_.height;
-  if (width == 0 || height == 0) return;
+  const Tile window = output_window();
+  if (width == 0 || height == 0 || window.x1 == window.x0 || window.y1 == window.y0) return;
 
   const ParamValues& v = params_;
-  const CameraModel camera(camera_params(v), width, height);
+  const CameraModel camera = input_camera();
   TilePool& tiles = pool(v.get_int("threads"));
   Progress progress(progress_callback_, progress_user_);
 
@@ -296,7 +343,9 @@ void Job::run() {
       static_cast<float>(v.get_float("power")), static_cast<float>(v.get_float("strength")),
       static_cast<float>(v.get_float("remap_min")), static_cast<float>(v.get_float("remap_max"))};
   Progress uncancellable(nullptr, nullptr);
-  tiles.for_each_tile(width, height, uncancellable, [&](const Tile& t) {
+  const int dx = window.x0, dy = window.y0;  // output pixel (x - dx, y - dy) is frame pixel (x, y)
+  tiles.for_each_tile(window.x1 - dx, window.y1 - dy, uncancellable, [&](const Tile& output) {
+    const Tile t{output.x0 + dx, output.y0 + dy, output.x1 + dx, output.y1 + dy};
     std::vector<float> denoised(size_t(t.x1 - t.x0) * size_t(t.y1 - t.y0));
     if (!frame.has_geometry(t.x0, t.y0, t.x1, t.y1)) {
       std::fill(denoised.begin(), denoised.end(), 1.0f);  // sky
@@ -312,16 +361,16 @@ void Job::run() {
       for (int x = t.x0; x < t.x1; ++x) {
         const float ao = values[x - t.x0];
         if (ao_out_.attached()) {
-          float* out = ao_out_.pixel(x, y);
+          float* out = ao_out_.pixel(x - dx, y - dy);
           for (int c = 0; c < std::min(ao_out_.channels, 3); ++c) out[c] = ao;
           if (ao_out_.channels == 4) out[3] = 1.0f;
         }
         if (composite_out_.attached()) {
-          const float* src = beauty_.pixel(x, y);
-          float* dst = composite_out_.pixel(x, y);
+          const float* src = beauty_.pixel(x - dx, y - dy);
+          float* dst = composite_out_.pixel(x - dx, y - dy);
           if (ambient_.attached()) {
             // Only the ambient part darkens; never below 0 where the beauty is not.
-            const float* ambient = ambient_.pixel(x, y);
+            const float* ambient = ambient_.pixel(x - dx, y - dy);
             for (int c = 0; c < composite_out_.channels; ++c) {
               const float darker = src[c] - (1.0f - ao) * ambient[c];
               dst[c] = c >= 3 ? src[c] : (darker < 0.0f && src[c] >= 0.0f ? 0.0f : darker);

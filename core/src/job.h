@@ -25,12 +25,21 @@ class Job {
     progress_callback_ = callback;
     progress_user_ = user;
   }
+  // Overscan (ssao.h ssao_job_set_output_window): the outputs are the window of the input
+  // images whose top-left pixel is (x, y).
+  void set_output_window(bool enable, int x, int y);
   void run();
   // The automatic radius rule (docs/parameters.md) for the attached depth image and camera.
   double auto_radius() const;
 
  private:
   void validate_images() const;
+  // The output window in input pixels: (x, y) and the outputs' size (the whole depth image
+  // without a window, or while no output is attached).
+  Tile output_window() const;
+  // The camera of the input images: the parameters' camera (which describes the output
+  // window) moved to the window's place on the input's pixel grid.
+  CameraModel input_camera() const;
 
   TilePool& pool(int threads);
 
@@ -42,6 +51,8 @@ class Job {
   Frame frame_, half_frame_;
   std::vector<float> visibility_;
   ImageView depth_, normal_, beauty_, ambient_, ao_out_, composite_out_;
+  bool windowed_ = false;
+  int window_x_ = 0, window_y_ = 0;
   Progress::Callback progress_callback_ = nullptr;
   void* progress_user_ = nullptr;
 };
