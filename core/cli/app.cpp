@@ -22,7 +22,9 @@ namespace {
 
 namespace fs = std::filesystem;
 
-// The input image with the passes the core reads, each tightly packed.
+// The input image with the passes the core reads, each tightly packed. With overscan (an EXR
+// whose data window is larger than its display window) the passes hold the whole data window:
+// the AO of the frame (image.frame_*) is computed from all of it.
 struct Inputs {
   ssao_io::Image image;
   ssao_io::PassChannels passes;
@@ -94,7 +96,7 @@ std::vector<int> channel_indices(const ssao_io::Image& image, const std::vector<
 
 Inputs load_inputs(const Options& options) {
   Inputs in;
-  in.image = ssao_io::read_image(options.input);
+  in.image = ssao_io::read_image(options.input, ssao_io::Overscan::read);
   ssao_io::PassOverrides overrides;
   overrides.layer = options.layer;
   overrides.depth_channel = options.depth_channel;
@@ -126,16 +128,23 @@ Inputs load_inputs(const Options& options) {
 }
 
 void attach_images(ssao_io::Job& job, Inputs& in, Outputs& out) {
-  const int w = in.image.width;
-  const int h = in.image.height;
-  job.set_image("depth", in.depth.data(), w, h, 1);
-  if (!in.normal.empty()) job.set_image("normal", in.normal.data(), w, h, 3);
-  out.ao.assign(in.image.pixel_count(), 0.0f);
+  const ssao_io::Image& image = in.image;
+  job.set_image("depth", in.depth.data(), image.width, image.height, 1);
+  if (!in.normal.empty()) job.set_image("normal", in.normal.data(), image.width, image.height, 3);
+  // The outputs are the frame; the beauty is read in place, the frame's window of the data.
+  const int w = image.frame_width, h = image.frame_height;
+  job.set_output_window(image.has_overscan(), image.frame_x, image.frame_y);
+  out.ao.assign(image.frame_pixel_count(), 0.0f);
   job.set_image("ao", out.ao.data(), w, h, 1);
   if (!in.beauty.empty()) {
-    out.composite.assign(in.beauty.size(), 0.0f);
-    job.set_image("beauty", in.beauty.data(), w, h, in.beauty_channels());
-    job.set_image("composite", out.composite.data(), w, h, in.beauty_channels());
+    const int channels = in.beauty_channels();
+    out.composite.assign(image.frame_pixel_count() * size_t(channels), 0.0f);
+    float* frame_beauty =
+        in.beauty.data() +
+        (size_t(image.frame_y) * size_t(image.width) + size_t(image.frame_x)) * size_t(channels);
+    const std::ptrdiff_t pixel_bytes = std::ptrdiff_t(channels * sizeof(float));
+    job.set_image("beauty", frame_beauty, w, h, channels, pixel_bytes, pixel_bytes * image.width);
+    job.set_image("composite", out.composite.data(), w, h, channels);
   }
 }
 
@@ -171,9 +180,10 @@ double compute_ao(ssao_io::Job& job, bool quiet) {
 void write_output(const Options& options, const Inputs& in, const Outputs& out) {
   const auto write =
       ssao_io::is_preview_path(options.output) ? ssao_io::write_preview : ssao_io::write_exr;
-  const size_t pixels = in.image.pixel_count();
+  const size_t pixels = in.image.frame_pixel_count();
+  const int width = in.image.frame_width, height = in.image.frame_height;
   if (out.composite.empty()) {
-    write(options.output, in.image.width, in.image.height, {"AO"}, out.ao);
+    write(options.output, width, height, {"AO"}, out.ao);
     return;
   }
   std::vector<std::string> names = {"R", "G", "B", "A"};
@@ -186,7 +196,7 @@ void write_output(const Options& options, const Inputs& in, const Outputs& out) 
     for (size_t c = 0; c < beauty; ++c) interleaved[p * stride + c] = out.composite[p * beauty + c];
     interleaved[p * stride + beauty] = out.ao[p];
   }
-  write(options.output, in.image.width, in.image.height, names, interleaved);
+  write(options.output, width, height, names, interleaved);
 }
 
 // The same test as the core's: finite, > 0, below background_depth and clip_end (when > 0).
@@ -195,16 +205,21 @@ bool is_geometry(float depth, double background_depth, double clip_end) {
          (clip_end <= 0.0 || depth < clip_end);
 }
 
-// Mean AO over the geometry pixels ("n/a" without any) and their count.
+// Mean AO over the frame's geometry pixels ("n/a" without any) and their count.
 std::string mean_ao(const ssao_io::Job& job, const Inputs& in, const Outputs& out, size_t& count) {
   const double background_depth = job.get_float("background_depth");
   const double clip_end = job.get_float("clip_end");
+  const ssao_io::Image& image = in.image;
   double sum = 0.0;
   count = 0;
-  for (size_t p = 0; p < in.depth.size(); ++p) {
-    if (!is_geometry(in.depth[p], background_depth, clip_end)) continue;
-    sum += out.ao[p];
-    ++count;
+  for (int y = 0; y < image.frame_height; ++y) {
+    for (int x = 0; x < image.frame_width; ++x) {
+      const float depth =
+          in.depth[size_t(y + image.frame_y) * size_t(image.width) + size_t(x + image.frame_x)];
+      if (!is_geometry(depth, background_depth, clip_end)) continue;
+      sum += out.ao[size_t(y) * size_t(image.frame_width) + size_t(x)];
+      ++count;
+    }
   }
   char mean[64] = "n/a";
   if (count > 0) std::snprintf(mean, sizeof mean, "%.4f", sum / static_cast<double>(count));
@@ -218,7 +233,7 @@ void print_summary(const Options& options, const ssao_io::Job& job, const Inputs
   std::fprintf(stderr,
                "ssao: %s: %dx%d, variant %s, normals %s, %.1f ms, mean AO %s over "
                "%zu geometry pixels\n",
-               options.output.c_str(), in.image.width, in.image.height,
+               options.output.c_str(), in.image.frame_width, in.image.frame_height,
                job.settings_summary().c_str(), in.normal.empty() ? "from depth" : "from pass",
                milliseconds, mean.c_str(), count);
 }

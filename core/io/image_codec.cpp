@@ -14,6 +14,7 @@
 #include <cctype>
 #include <cerrno>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -168,11 +169,12 @@ void check_exr_header_sizes(const std::string& path) {
 
 // A multi-part EXR (Blender 5.x writes a multilayer file as one part per layer) reads as one
 // image with the channels of every part, in file order. Parts of another size are refused.
-void append_exr_parts(OIIO::ImageInput& input, const std::string& path, Image& image) {
+void append_exr_parts(OIIO::ImageInput& input, const std::string& path, Image& image,
+                      const OIIO::ImageSpec& first) {
   for (int part = 1; input.seek_subimage(part, 0); ++part) {
     const OIIO::ImageSpec spec = input.spec();
-    if (spec.width != image.width || spec.height != image.height || spec.x != 0 || spec.y != 0 ||
-        spec.deep || spec.depth > 1) {
+    if (spec.width != image.width || spec.height != image.height || spec.x != first.x ||
+        spec.y != first.y || spec.deep || spec.depth > 1) {
       throw Error("cannot read " + quoted(path) + ": its part " + std::to_string(part) + " (" +
                   std::string(spec.get_string_attribute("name")) +
                   ") is not the size of the first");
@@ -209,18 +211,26 @@ Image read(const std::string& path) {
   if (spec.deep) throw Error("cannot read " + quoted(path) + ": deep images are not supported");
   if (spec.depth > 1)
     throw Error("cannot read " + quoted(path) + ": volume images are not supported");
-  if (spec.x != spec.full_x || spec.y != spec.full_y || spec.width != spec.full_width ||
-      spec.height != spec.full_height) {
+  // Overscan (a data window larger than the display window) is read whole; a data window that
+  // leaves part of the display window out has no pixels for it.
+  if (spec.x > spec.full_x || spec.y > spec.full_y ||
+      int64_t(spec.x) + spec.width < int64_t(spec.full_x) + spec.full_width ||
+      int64_t(spec.y) + spec.height < int64_t(spec.full_y) + spec.full_height) {
     throw Error("cannot read " + quoted(path) + ": its data window (" + std::to_string(spec.width) +
                 " x " + std::to_string(spec.height) + " at " + std::to_string(spec.x) + ", " +
-                std::to_string(spec.y) + ") differs from its display window (" +
+                std::to_string(spec.y) + ") does not cover its display window (" +
                 std::to_string(spec.full_width) + " x " + std::to_string(spec.full_height) +
-                "); crop or pad it to the full frame first");
+                " at " + std::to_string(spec.full_x) + ", " + std::to_string(spec.full_y) +
+                "); pad it to the full frame first");
   }
 
   Image image;
   image.width = spec.width;
   image.height = spec.height;
+  image.frame_x = spec.full_x - spec.x;
+  image.frame_y = spec.full_y - spec.y;
+  image.frame_width = spec.full_width;
+  image.frame_height = spec.full_height;
   image.color_space = spec.get_string_attribute("oiio:ColorSpace");
   const size_t count = checked_float_count(spec.width, spec.height, spec.nchannels, path);
   for (int c = 0; c < spec.nchannels; ++c) image.channel_names.push_back(spec.channel_name(c));
@@ -237,7 +247,9 @@ Image read(const std::string& path) {
     throw Error("cannot read " + quoted(path) + ": the file is truncated or corrupt (" +
                 oiio_detail(input->geterror()) + ")");
   }
-  if (std::string(input->format_name()) == "openexr") append_exr_parts(*input, path, image);
+  if (std::string(input->format_name()) == "openexr") {
+    append_exr_parts(*input, path, image, spec);
+  }
   input->close();
   return image;
 }

@@ -74,10 +74,17 @@ std::string join_names(const std::vector<std::string>& names, const char* separa
   return out;
 }
 
-Image read_image(const std::string& path) {
+Image read_image(const std::string& path, Overscan overscan) {
   Image image;
   std::string error;
   if (!codec().read(path, image, error)) throw Error(error);
+  if (image.has_overscan() && overscan == Overscan::refuse) {
+    throw Error("cannot read " + quoted(path) + ": its data window (" +
+                std::to_string(image.width) + " x " + std::to_string(image.height) +
+                ") is larger than its display window (" + std::to_string(image.frame_width) +
+                " x " + std::to_string(image.frame_height) +
+                "); crop it to the display window first");
+  }
   return image;
 }
 

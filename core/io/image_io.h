@@ -24,7 +24,15 @@ struct Image {
   // "sRGB", "GammaCorrected2.2", ...; "" if the file does not say). read_image() returns the
   // stored values as they are (an 8-bit sRGB PNG reads as its code values / 255).
   std::string color_space;
+  // The frame (OpenEXR's display window) inside the pixels (its data window): pixel (0, 0) of
+  // the frame is pixel (frame_x, frame_y) here. The whole image unless the file has overscan
+  // (a data window larger than the display window).
+  int frame_x = 0, frame_y = 0, frame_width = 0, frame_height = 0;
 
+  bool has_overscan() const { return frame_width != width || frame_height != height; }
+  size_t frame_pixel_count() const {
+    return static_cast<size_t>(frame_width) * static_cast<size_t>(frame_height);
+  }
   int channels() const { return static_cast<int>(channel_names.size()); }
   size_t pixel_count() const { return static_cast<size_t>(width) * static_cast<size_t>(height); }
 
@@ -32,10 +40,14 @@ struct Image {
   int find_channel(const std::string& name) const;
 };
 
+enum class Overscan { refuse, read };
+
 // Reads the first subimage of `path` as 32-bit float. Throws Error for a missing file, a file
 // that is not an image OIIO can read, a truncated or corrupt file (OIIO's message included), a
-// deep image, or a data window that differs from the display window.
-Image read_image(const std::string& path);
+// deep image, a data window that does not cover the display window, or, unless `overscan` is
+// read, a data window larger than the display window (overscan: with Overscan::read the whole
+// data window is read, and frame_* locate the display window in it).
+Image read_image(const std::string& path, Overscan overscan = Overscan::refuse);
 
 // Converts the stored values of an image read from an sRGB- or gamma-encoded file
 // (color_space "sRGB", "GammaCorrected<g>" or "Gamma<g>", e.g. an 8-bit PNG) to linear light,

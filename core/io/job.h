@@ -115,6 +115,11 @@ class Job {
                                     row_stride),
                  "image " + name);
   }
+  // Overscan: the outputs are the window at (x, y) of the input images
+  // (ssao_job_set_output_window).
+  void set_output_window(bool enable, int x, int y) {
+    check_status(ssao_job_set_output_window(job_, enable ? 1 : 0, x, y), "output window");
+  }
   void set_progress(ssao_progress_fn fn, void* user) {
     check_status(ssao_job_set_progress(job_, fn, user), "progress callback");
   }

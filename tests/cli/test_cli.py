@@ -501,6 +501,98 @@ class SequenceTest(CliTestCase):
         self.assertEqual(proc.returncode, 0, proc.stderr)
 
 
+class OverscanTest(CliTestCase):
+    """An EXR whose data window is larger than its display window (overscan, a guard band on the
+    same pixel grid): AO for the display window from all of the data window. The standard 64x48
+    scene is the data window; the display window is its middle, BAND pixels in from each side."""
+
+    BAND = 8
+
+    def write_overscan_exr(self, path, data_x=None, data_y=None):
+        """The standard scene as an EXR with data window 64x48 at (-BAND, -BAND) (or the given
+        origin) and display window (WIDTH - 2 BAND) x (HEIGHT - 2 BAND) at (0, 0)."""
+        pixels = np.stack([self.planes[n] for n in BLENDER_CHANNELS], axis=-1).astype(np.float32)
+        spec = oiio.ImageSpec(WIDTH, HEIGHT, len(BLENDER_CHANNELS), oiio.FLOAT)
+        spec.channelnames = tuple(BLENDER_CHANNELS)
+        spec.alpha_channel = -1
+        spec.x = -self.BAND if data_x is None else data_x
+        spec.y = -self.BAND if data_y is None else data_y
+        spec.full_x, spec.full_y = 0, 0
+        spec.full_width, spec.full_height = WIDTH - 2 * self.BAND, HEIGHT - 2 * self.BAND
+        out = oiio.ImageOutput.create(path)
+        self.assertTrue(out.open(path, spec), out.geterror())
+        self.assertTrue(out.write_image(pixels), out.geterror())
+        out.close()
+        return path
+
+    def frame_camera(self):
+        """The display window's camera: the standard camera narrowed to the frame on the same
+        pixel grid (the sensor spans the width: it shrinks with it)."""
+        return self.write_camera(dict(CAMERA, sensor_width=CAMERA["sensor_width"] *
+                                      (WIDTH - 2 * self.BAND) / WIDTH), "frame_camera.json")
+
+    def crop(self, image):
+        return image[self.BAND:HEIGHT - self.BAND, self.BAND:WIDTH - self.BAND]
+
+    def test_the_frame_gets_the_ao_of_the_whole_data_window_cropped(self):
+        self.assert_ok(self.run_ssao())  # the whole 64x48 image with the standard camera
+        names, whole = read_image(self.output)
+        overscan = self.write_overscan_exr(self.path("overscan.exr"))
+        frame_output = self.path("frame.exr")
+        proc = self.run_ssao(overscan, "-o", frame_output, "--camera", self.frame_camera(),
+                             "--radius", RADIUS, default_paths=False)
+        self.assertEqual(proc.returncode, 0, proc.stderr)
+        frame_names, frame = read_image(frame_output)
+        self.assertEqual(frame_names, names)
+        self.assertEqual(frame.shape, (HEIGHT - 2 * self.BAND, WIDTH - 2 * self.BAND, len(names)))
+        # Both runs see the same pixels through the same camera: the same AO and composite.
+        np.testing.assert_allclose(frame, self.crop(whole), rtol=0, atol=1e-6)
+        ao = frame[:, :, names.index("AO")]
+        self.assertLess(float(ao.min()), 0.9, "the frame has occlusion to compare")
+        self.assertIn(f"{WIDTH - 2 * self.BAND}x{HEIGHT - 2 * self.BAND}", proc.stderr)
+        # Cropped to the display window first, the frame loses the occluders in the band.
+        spec = oiio.ImageSpec(WIDTH - 2 * self.BAND, HEIGHT - 2 * self.BAND,
+                              len(BLENDER_CHANNELS), oiio.FLOAT)
+        cropped_planes = {n: self.crop(self.planes[n]) for n in BLENDER_CHANNELS}
+        cropped = self.path("cropped.exr")
+        pixels = np.stack([cropped_planes[n] for n in BLENDER_CHANNELS], axis=-1)
+        spec.channelnames = tuple(BLENDER_CHANNELS)
+        out = oiio.ImageOutput.create(cropped)
+        self.assertTrue(out.open(cropped, spec) and out.write_image(pixels.astype(np.float32)))
+        out.close()
+        cropped_output = self.path("cropped_out.exr")
+        self.assertEqual(self.run_ssao(cropped, "-o", cropped_output, "--camera",
+                                       self.frame_camera(), "--radius", RADIUS, "--ao-only",
+                                       default_paths=False).returncode, 0)
+        _, without_band = read_image(cropped_output)
+        self.assertGreater(float(np.abs(without_band[:, :, 0] - ao).max()), 0.01,
+                           "the band holds occluders the frame's edge pixels see")
+
+    def test_sequences_and_chunks_read_overscan(self):
+        for frame in (1, 2):
+            self.write_overscan_exr(self.path(f"shot.{frame:04d}.exr"))
+        camera = self.frame_camera()
+        proc = self.run_ssao(self.path("shot.####.exr"), "-o", self.path("ao.####.exr"),
+                             "--camera", camera, "--radius", RADIUS, "--ao-only", "--frames",
+                             "1-2", "--chunk-size", "1", "--chunk-index", "1",
+                             default_paths=False)
+        self.assertEqual(proc.returncode, 0, proc.stderr)
+        self.assertFalse(os.path.exists(self.path("ao.0001.exr")), "chunk 1 is frame 2 alone")
+        _, sequence_frame = read_image(self.path("ao.0002.exr"))
+        self.assertEqual(self.run_ssao(self.path("shot.0002.exr"), "-o", self.path("one.exr"),
+                                       "--camera", camera, "--radius", RADIUS, "--ao-only",
+                                       default_paths=False).returncode, 0)
+        _, single = read_image(self.path("one.exr"))
+        np.testing.assert_array_equal(sequence_frame, single)
+        self.assertEqual(single.shape[:2], (HEIGHT - 2 * self.BAND, WIDTH - 2 * self.BAND))
+
+    def test_a_data_window_short_of_the_display_window_is_refused(self):
+        short = self.write_overscan_exr(self.path("short.exr"), data_x=1, data_y=0)
+        proc = self.run_ssao(short, "-o", self.output, "--camera", self.camera, "--radius",
+                             RADIUS, default_paths=False)
+        self.assert_fails(proc, 1, "does not cover its display window")
+
+
 class HelpTest(CliTestCase):
 
     def test_help_lists_every_parameter(self):

@@ -10,7 +10,8 @@
 // - structured (what the fuzzer explores): the input chooses what an EXR can hold and
 //   OpenImageIO writes it: sizes, 1 to 3 parts (of equal or different sizes), channel names
 //   (Blender's <layer>.<pass>.<channel>, plain R/G/B/A/Z, duplicates, random strings), half or
-//   float, tiles, compression, a data window that is not the display window, a colour-space
+//   float, tiles, compression, a data window that is not the display window (short of it, or
+//   larger: overscan, which the CLI reads), a colour-space
 //   attribute, pixel values as raw bits (NaN, Inf, denormals);
 // - raw (SSAO_FUZZ_RAW=1, how scripts/fuzz.sh replays the *.exr files of
 //   tests/fuzz/regressions/fuzz_exr/ and the seeds make_exr_seeds writes): the input's bytes are
@@ -110,10 +111,15 @@ bool write_structured(FuzzedDataProvider& in, const std::string& path) {
     spec.alpha_channel = -1;
     spec.attribute("compression", in.PickValueInArray(compressions));
     if (tiled) spec.tile_width = spec.tile_height = 16;
-    if (in.ConsumeIntegralInRange<int>(0, 15) == 0) {  // data window inside a larger display
+    const int window = in.ConsumeIntegralInRange<int>(0, 15);
+    if (window == 0) {  // data window inside a larger display
       spec.x = 1;
       spec.full_width = spec.width + 2;
       spec.full_height = spec.height;
+    } else if (window == 1 && spec.width > 2 && spec.height > 1) {  // overscan around the display
+      spec.x = -1;
+      spec.full_width = spec.width - 2;
+      spec.full_height = spec.height - 1;
     }
     const size_t space = in.ConsumeIntegralInRange<size_t>(0, std::size(spaces));
     const std::string colour_space =
@@ -164,11 +170,15 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
 
   ssao_io::Image image;
   try {
-    image = ssao_io::read_image(path);
+    image = ssao_io::read_image(path, ssao_io::Overscan::read);
   } catch (const ssao_io::Error&) {
     return 0;  // refused with a message: what the CLI prints
   }
   check(image.width >= 0 && image.height >= 0, "negative size");
+  check(image.frame_x >= 0 && image.frame_y >= 0 && image.frame_width >= 0 &&
+            image.frame_height >= 0 && image.frame_x + image.frame_width <= image.width &&
+            image.frame_y + image.frame_height <= image.height,
+        "the display window is not inside the data window read");
   check(image.pixels.size() == image.pixel_count() * size_t(image.channels()),
         "pixel buffer does not match width x height x channels");
   ssao_io::linearize(image);
@@ -198,19 +208,26 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   check(depth.size() == image.pixel_count(), "depth size");
 
   // The library on what was read, as the CLI attaches it (small images only: speed).
-  if (image.pixel_count() == 0 || image.pixel_count() > 4096) return 0;
+  if (image.frame_pixel_count() == 0 || image.pixel_count() > 4096) return 0;
   const int w = image.width, h = image.height;
+  const int fw = image.frame_width, fh = image.frame_height;
   try {
     ssao_io::Job job;
     job.set("threads", 1);
     job.set_image("depth", depth.data(), w, h, 1);
     if (!normal.empty()) job.set_image("normal", normal.data(), w, h, 3);
-    std::vector<float> ao(image.pixel_count(), -1.0f), composite(beauty.size());
-    job.set_image("ao", ao.data(), w, h, 1);
+    job.set_output_window(image.has_overscan(), image.frame_x, image.frame_y);
     const int beauty_channels = static_cast<int>(passes.beauty.size());
+    std::vector<float> ao(image.frame_pixel_count(), -1.0f),
+        composite(image.frame_pixel_count() * size_t(beauty_channels));
+    job.set_image("ao", ao.data(), fw, fh, 1);
     if (!beauty.empty()) {
-      job.set_image("beauty", beauty.data(), w, h, beauty_channels);
-      job.set_image("composite", composite.data(), w, h, beauty_channels);
+      const std::ptrdiff_t pixel_bytes = std::ptrdiff_t(beauty_channels * sizeof(float));
+      float* frame_beauty =
+          beauty.data() +
+          (size_t(image.frame_y) * size_t(w) + size_t(image.frame_x)) * size_t(beauty_channels);
+      job.set_image("beauty", frame_beauty, fw, fh, beauty_channels, pixel_bytes, pixel_bytes * w);
+      job.set_image("composite", composite.data(), fw, fh, beauty_channels);
     }
     job.run();
     for (float v : ao) check(v >= 0.0f && v <= 1.0f, "AO outside [0, 1] or NaN");
