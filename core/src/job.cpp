@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <cstring>
 #include <limits>
 #include <vector>
@@ -112,6 +113,15 @@ void Job::set_output_window(bool enable, int x, int y) {
 Tile Job::output_window() const {
   const ImageView& out = ao_out_.attached() ? ao_out_ : composite_out_;
   if (!windowed_ || !out.attached()) return {0, 0, depth_.width, depth_.height};
+  // In 64 bits: a window far beyond the image must not overflow on the way to its refusal.
+  if (int64_t(window_x_) + out.width > depth_.width ||
+      int64_t(window_y_) + out.height > depth_.height) {
+    throw_invalid_argument("the output window " + std::to_string(out.width) + "x" +
+                           std::to_string(out.height) + " at (" + std::to_string(window_x_) + ", " +
+                           std::to_string(window_y_) + ") does not fit in the " +
+                           std::to_string(depth_.width) + "x" + std::to_string(depth_.height) +
+                           " depth image");
+  }
   return {window_x_, window_y_, window_x_ + out.width, window_y_ + out.height};
 }
 
@@ -251,12 +261,6 @@ void Job::validate_images() const {
                            (windowed_ ? "the output window is " + std::to_string(window_width) +
                                             "x" + std::to_string(window_height)
                                       : "depth is " + size(depth_)));
-  }
-  if (window.x1 > depth_.width || window.y1 > depth_.height) {
-    throw_invalid_argument("the output window " + std::to_string(window_width) + "x" +
-                           std::to_string(window_height) + " at (" + std::to_string(window.x0) +
-                           ", " + std::to_string(window.y0) + ") does not fit in the " +
-                           size(depth_) + " depth image");
   }
   if (composite_out_.attached()) {
     if (!beauty_.attached()) throw_invalid_operation("'composite' output needs a 'beauty' image");

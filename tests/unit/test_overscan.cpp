@@ -152,6 +152,14 @@ TEST(Overscan, BadWindowsAreRefused) {
       << ssao_last_error();
   ASSERT_EQ(ssao_job_set_output_window(job.get(), 1, 0, 2 * kBand + 1), SSAO_OK);
   EXPECT_EQ(job.run(), SSAO_ERROR_INVALID_ARGUMENT);
+  // Far beyond (no overflow on the way: UBSan), also for the automatic radius, which reads the
+  // window's depths.
+  ASSERT_EQ(ssao_job_set_output_window(job.get(), 1, 2147483647, 2147483647), SSAO_OK);
+  EXPECT_EQ(job.run(), SSAO_ERROR_INVALID_ARGUMENT);
+  double radius = 0.0;
+  EXPECT_EQ(ssao_job_auto_radius(job.get(), &radius), SSAO_ERROR_INVALID_ARGUMENT);
+  EXPECT_NE(std::strstr(ssao_last_error(), "does not fit in the 144x112 depth image"), nullptr)
+      << ssao_last_error();
   // The last pixel fits.
   ASSERT_EQ(ssao_job_set_output_window(job.get(), 1, 2 * kBand, 2 * kBand), SSAO_OK);
   EXPECT_EQ(job.run(), SSAO_OK) << ssao_last_error();
