@@ -104,6 +104,8 @@ def _declare(lib):
     sig("ssao_job_get_string", c_int, job, cstr, ctypes.c_char_p, ctypes.c_size_t)
     sig("ssao_job_set_image", c_int, job, cstr, ctypes.c_void_p, c_int, c_int, c_int,
         ctypes.c_ssize_t, ctypes.c_ssize_t)
+    if hasattr(lib, "ssao_job_set_output_window"):  # since 0.1 after 7bf6fcd (overscan)
+        sig("ssao_job_set_output_window", c_int, job, c_int, c_int, c_int)
     sig("ssao_job_set_progress", c_int, job, _PROGRESS_FN, ctypes.c_void_p)
     sig("ssao_job_run", c_int, job)
 
@@ -200,6 +202,10 @@ class Job:
         self._lib.ssao_job_set_image(self._job, name.encode(), array.ctypes.data, width, height,
                                      channels, pixel_stride, array.strides[0])
         self._images[name] = array
+
+    def set_output_window(self, x, y, enable=True):
+        """Overscan: the outputs are the window at (x, y) of the depth image (ssao.h)."""
+        self._lib.ssao_job_set_output_window(self._job, int(enable), int(x), int(y))
 
     def run(self, progress=None):
         """Runs the job. progress(fraction) may return False to cancel."""

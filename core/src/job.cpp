@@ -94,6 +94,11 @@ constexpr double kHalfResolutionPixels = 1e6;
 // development scenes (docs/parameters.md): their ratio is 0.06 to 0.14, geometric mean 0.100.
 constexpr double kAutoRadiusFraction = 0.1;
 
+// Pixels around the output window (in the estimated frame's pixels) whose estimates reach it:
+// each denoise pass reads 2 pixels to either side, the upsampling 1 half-resolution pixel; with
+// room to spare. tests/unit/test_overscan.cpp holds the result to the whole frame's, bit for bit.
+constexpr int kDenoiseReach = 8;
+
 // Depth samples read for the median: every pixel up to this many, else a regular subset.
 constexpr size_t kAutoRadiusSamples = 1u << 20;
 
@@ -329,9 +334,18 @@ void Job::run() {
   progress.set_stage(0.05, 0.95);
   std::vector<float>& visibility = visibility_;
   visibility.assign(estimates, 1.0f);
-  tiles.for_each_tile(seen.width(), seen.height(), progress, [&](const Tile& t) {
+  // With overscan, estimates are needed only where the denoise and the upsampling reach the
+  // output window from; the rest of the guard band is context that samples read.
+  const int scale = half_resolution ? 2 : 1;
+  const Tile needed{std::max(window.x0 / scale - kDenoiseReach, 0),
+                    std::max(window.y0 / scale - kDenoiseReach, 0),
+                    std::min((window.x1 + scale - 1) / scale + kDenoiseReach, seen.width()),
+                    std::min((window.y1 + scale - 1) / scale + kDenoiseReach, seen.height())};
+  tiles.for_each_tile(seen.width(), seen.height(), progress, [&](const Tile& tile) {
+    const Tile t{std::max(tile.x0, needed.x0), std::max(tile.y0, needed.y0),
+                 std::min(tile.x1, needed.x1), std::min(tile.y1, needed.y1)};
     // A tile of background costs one pass over its depths.
-    if (!seen.has_geometry(t.x0, t.y0, t.x1, t.y1)) return;
+    if (t.x0 >= t.x1 || t.y0 >= t.y1 || !seen.has_geometry(t.x0, t.y0, t.x1, t.y1)) return;
     variant->estimate(seen, t, visibility.data());
   });
 

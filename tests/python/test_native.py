@@ -86,6 +86,25 @@ class NativeBindingTest(unittest.TestCase):
             with self.assertRaisesRegex(ssao_native.SSAOError, "cancelled"):
                 job.run(progress=lambda f: False)
 
+    def test_output_window_takes_the_frame_out_of_a_larger_depth(self):
+        # The corner scene as a guard band around its middle: the window's AO is the whole
+        # run's, cropped, since the camera is the same on the same pixel grid.
+        depth = corner_scene()
+        whole = self.run_ao(depth, radius=1.0)
+        frame = np.zeros((48 - 2 * 8, 64 - 2 * 8), np.float32)
+        with ssao_native.Job(self.lib) as job:
+            job.set("radius", 1.0)
+            job.set("lens", 35.0)
+            job.set("sensor_width", 36.0 * 48 / 64)  # the frame is 48 of the 64 px wide
+            job.set_image("depth", depth)
+            job.set_image("ao", frame)
+            job.set_output_window(8, 8)
+            job.run()
+            np.testing.assert_array_equal(frame, whole[8:40, 8:56])
+            job.set_output_window(17, 8)
+            with self.assertRaisesRegex(ssao_native.SSAOError, "does not fit in the 64x48"):
+                job.run()
+
 
 if __name__ == "__main__":
     LIBRARY = sys.argv.pop(1) if len(sys.argv) > 1 else None
