@@ -139,11 +139,8 @@ void attach_images(ssao_io::Job& job, Inputs& in, Outputs& out) {
   if (!in.beauty.empty()) {
     const int channels = in.beauty_channels();
     out.composite.assign(image.frame_pixel_count() * size_t(channels), 0.0f);
-    float* frame_beauty =
-        in.beauty.data() +
-        (size_t(image.frame_y) * size_t(image.width) + size_t(image.frame_x)) * size_t(channels);
-    const std::ptrdiff_t pixel_bytes = std::ptrdiff_t(channels * sizeof(float));
-    job.set_image("beauty", frame_beauty, w, h, channels, pixel_bytes, pixel_bytes * image.width);
+    const ssao_io::FrameView beauty = ssao_io::frame_view(image, in.beauty, channels);
+    job.set_image("beauty", beauty.data, w, h, channels, beauty.pixel_stride, beauty.row_stride);
     job.set_image("composite", out.composite.data(), w, h, channels);
   }
 }

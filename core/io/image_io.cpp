@@ -141,6 +141,14 @@ std::vector<float> extract_channels(const Image& image, const std::vector<int>& 
   return out;
 }
 
+FrameView frame_view(const Image& image, std::vector<float>& pass, int channels) {
+  const size_t first = static_cast<size_t>(image.frame_y) * static_cast<size_t>(image.width) +
+                       static_cast<size_t>(image.frame_x);
+  const std::ptrdiff_t pixel_bytes = std::ptrdiff_t(channels) * std::ptrdiff_t(sizeof(float));
+  return {pass.data() + first * static_cast<size_t>(channels), pixel_bytes,
+          pixel_bytes * image.width};
+}
+
 void write_exr(const std::string& path, int width, int height,
                const std::vector<std::string>& channel_names, const std::vector<float>& pixels) {
   std::string error;

@@ -63,6 +63,14 @@ int require_channel(const Image& image, const std::string& name, const std::stri
 // of width * height * indices.size() floats.
 std::vector<float> extract_channels(const Image& image, const std::vector<int>& indices);
 
+// The frame's window (frame_*) of a pass extracted from `image` (`channels` floats a pixel,
+// tightly packed): its first pixel and byte strides, as ssao_job_set_image takes them.
+struct FrameView {
+  float* data;
+  std::ptrdiff_t pixel_stride, row_stride;
+};
+FrameView frame_view(const Image& image, std::vector<float>& pass, int channels);
+
 // Writes `pixels` (interleaved, top row first, channel_names.size() channels) as a 32-bit float,
 // ZIP-compressed OpenEXR file, whatever the extension of `path`. The data go to a temporary
 // file in the same folder, which is renamed to `path` only once complete, so a failed write

@@ -130,8 +130,7 @@ Tile Job::output_window() const {
   return {window_x_, window_y_, window_x_ + out.width, window_y_ + out.height};
 }
 
-CameraModel Job::input_camera() const {
-  const Tile w = output_window();
+CameraModel Job::input_camera(const Tile& w) const {
   return CameraModel(camera_params(params_), std::max(w.x1 - w.x0, 1), std::max(w.y1 - w.y0, 1))
       .moved_by(w.x0, w.y0);
 }
@@ -142,7 +141,7 @@ double Job::auto_radius() const {
   const Tile window = output_window();
   const int width = window.x1 - window.x0, height = window.y1 - window.y0;
   const ParamValues& v = params_;
-  const CameraModel camera = input_camera();
+  const CameraModel camera = input_camera(window);
   const bool radial = v.get_string("depth_kind") == "radial";
   double limit = v.get_float("background_depth");
   if (v.get_float("clip_end") > 0.0) limit = std::min(limit, v.get_float("clip_end"));
@@ -290,11 +289,12 @@ TilePool& Job::pool(int threads) {
 void Job::run() {
   validate_images();
   const int width = depth_.width, height = depth_.height;
+  // An empty window (an empty depth image among them: the window lies inside it) does nothing.
   const Tile window = output_window();
-  if (width == 0 || height == 0 || window.x1 == window.x0 || window.y1 == window.y0) return;
+  if (window.x1 == window.x0 || window.y1 == window.y0) return;
 
   const ParamValues& v = params_;
-  const CameraModel camera = input_camera();
+  const CameraModel camera = input_camera(window);
   TilePool& tiles = pool(v.get_int("threads"));
   Progress progress(progress_callback_, progress_user_);
 

@@ -38,8 +38,8 @@ class Job {
   // without a window, or while no output is attached).
   Tile output_window() const;
   // The camera of the input images: the parameters' camera (which describes the output
-  // window) moved to the window's place on the input's pixel grid.
-  CameraModel input_camera() const;
+  // window, output_window()) moved to the window's place on the input's pixel grid.
+  CameraModel input_camera(const Tile& window) const;
 
   TilePool& pool(int threads);
 

@@ -89,13 +89,21 @@ def make_scene():
     return planes
 
 
-def write_exr(path, planes, names=None):
+def write_exr(path, planes, names=None, data_origin=None, display_size=None):
+    """The planes as an EXR of their size. data_origin=(x, y) and display_size=(w, h) place the
+    data window (the planes) and the display window at (0, 0) apart: overscan, or a data
+    window short of the display window."""
     names = list(planes.keys()) if names is None else names
     pixels = np.stack([planes[n] for n in names], axis=-1).astype(np.float32)
-    spec = oiio.ImageSpec(WIDTH, HEIGHT, len(names), oiio.FLOAT)
+    height, width = pixels.shape[:2]
+    spec = oiio.ImageSpec(width, height, len(names), oiio.FLOAT)
     spec.channelnames = tuple(names)
     spec.alpha_channel = -1
     spec.attribute("compression", "zip")
+    if data_origin is not None:
+        spec.x, spec.y = data_origin
+        spec.full_x, spec.full_y = 0, 0
+        spec.full_width, spec.full_height = display_size
     out = oiio.ImageOutput.create(path)
     assert out is not None, oiio.geterror()
     assert out.open(path, spec), out.geterror()
@@ -511,18 +519,10 @@ class OverscanTest(CliTestCase):
     def write_overscan_exr(self, path, data_x=None, data_y=None):
         """The standard scene as an EXR with data window 64x48 at (-BAND, -BAND) (or the given
         origin) and display window (WIDTH - 2 BAND) x (HEIGHT - 2 BAND) at (0, 0)."""
-        pixels = np.stack([self.planes[n] for n in BLENDER_CHANNELS], axis=-1).astype(np.float32)
-        spec = oiio.ImageSpec(WIDTH, HEIGHT, len(BLENDER_CHANNELS), oiio.FLOAT)
-        spec.channelnames = tuple(BLENDER_CHANNELS)
-        spec.alpha_channel = -1
-        spec.x = -self.BAND if data_x is None else data_x
-        spec.y = -self.BAND if data_y is None else data_y
-        spec.full_x, spec.full_y = 0, 0
-        spec.full_width, spec.full_height = WIDTH - 2 * self.BAND, HEIGHT - 2 * self.BAND
-        out = oiio.ImageOutput.create(path)
-        self.assertTrue(out.open(path, spec), out.geterror())
-        self.assertTrue(out.write_image(pixels), out.geterror())
-        out.close()
+        write_exr(path, self.planes, BLENDER_CHANNELS,
+                  data_origin=(-self.BAND if data_x is None else data_x,
+                               -self.BAND if data_y is None else data_y),
+                  display_size=(WIDTH - 2 * self.BAND, HEIGHT - 2 * self.BAND))
         return path
 
     def frame_camera(self):
@@ -551,15 +551,8 @@ class OverscanTest(CliTestCase):
         self.assertLess(float(ao.min()), 0.9, "the frame has occlusion to compare")
         self.assertIn(f"{WIDTH - 2 * self.BAND}x{HEIGHT - 2 * self.BAND}", proc.stderr)
         # Cropped to the display window first, the frame loses the occluders in the band.
-        spec = oiio.ImageSpec(WIDTH - 2 * self.BAND, HEIGHT - 2 * self.BAND,
-                              len(BLENDER_CHANNELS), oiio.FLOAT)
-        cropped_planes = {n: self.crop(self.planes[n]) for n in BLENDER_CHANNELS}
         cropped = self.path("cropped.exr")
-        pixels = np.stack([cropped_planes[n] for n in BLENDER_CHANNELS], axis=-1)
-        spec.channelnames = tuple(BLENDER_CHANNELS)
-        out = oiio.ImageOutput.create(cropped)
-        self.assertTrue(out.open(cropped, spec) and out.write_image(pixels.astype(np.float32)))
-        out.close()
+        write_exr(cropped, {n: self.crop(self.planes[n]) for n in BLENDER_CHANNELS})
         cropped_output = self.path("cropped_out.exr")
         self.assertEqual(self.run_ssao(cropped, "-o", cropped_output, "--camera",
                                        self.frame_camera(), "--radius", RADIUS, "--ao-only",

@@ -222,11 +222,9 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
         composite(image.frame_pixel_count() * size_t(beauty_channels));
     job.set_image("ao", ao.data(), fw, fh, 1);
     if (!beauty.empty()) {
-      const std::ptrdiff_t pixel_bytes = std::ptrdiff_t(beauty_channels * sizeof(float));
-      float* frame_beauty =
-          beauty.data() +
-          (size_t(image.frame_y) * size_t(w) + size_t(image.frame_x)) * size_t(beauty_channels);
-      job.set_image("beauty", frame_beauty, fw, fh, beauty_channels, pixel_bytes, pixel_bytes * w);
+      const ssao_io::FrameView view = ssao_io::frame_view(image, beauty, beauty_channels);
+      job.set_image("beauty", view.data, fw, fh, beauty_channels, view.pixel_stride,
+                    view.row_stride);
       job.set_image("composite", composite.data(), fw, fh, beauty_channels);
     }
     job.run();
