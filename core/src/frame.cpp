@@ -3,16 +3,45 @@
 
 #include <algorithm>
 #include <cmath>
+#include <string>
 
+#include "error.h"
 #include "simd.h"
 
 namespace ssao {
-void Frame::reset(const CameraModel& camera, int width, int height) {
+// A layer may be this much (relative) nearer than the one before it and still be taken as the
+// same depth: two renders of one surface agree to about 1e-5 (Cycles, measured), a half-float
+// EXR rounds to 5e-4.
+constexpr float kLayerOrderTolerance = 1e-3f;
+
+void Frame::reset(const CameraModel& camera, int width, int height, int extra_layers) {
   camera_ = camera;
   width_ = width;
   height_ = height;
+  extra_layers_ = extra_layers;
   depth_.resize(size_t(width) * size_t(height));
   normal_.resize(size_t(width) * size_t(height));
+  layers_.resize(size_t(extra_layers) * size_t(width) * size_t(height));
+}
+
+float Frame::solid_entry(int x, int y, float depth, bool& closed) const {
+  closed = false;
+  float entry = depth_[index(x, y)];
+  if (!(depth > entry)) return kBackground;  // in front of the visible surface
+  bool entered = true;                       // the visible surface is taken as a front face
+  for (int k = 0; k < extra_layers_; ++k) {
+    const float hit = layers_[size_t(k) * pixel_count() + index(x, y)];
+    const float hit_depth = std::fabs(hit);
+    const bool back = hit < 0.0f;
+    if (depth <= hit_depth) {  // the point lies between the last hit and this one
+      if (!entered) return kBackground;
+      closed = back;
+      return entry;
+    }
+    entry = hit_depth;
+    entered = !back;
+  }
+  return entered ? entry : kBackground;  // behind the last known hit
 }
 
 bool Frame::has_geometry(int x0, int y0, int x1, int y1) const {
@@ -33,6 +62,7 @@ void Frame::build(const FrameInputs& in, TilePool& pool, Progress& progress) {
       float* row = depth_.data() + index(t.x0, y);
       for (int x = t.x0; x < t.x1; ++x) row[x - t.x0] = in.depth.pixel(x, y)[0];
       depth_row(row, t.x0, t.x1 - t.x0, float(y) + 0.5f, in.radial_depth, limit);
+      for (int k = 0; k < extra_layers_; ++k) layer_row(in, k, t.x0, t.x1 - t.x0, y, limit);
     }
   });
 
@@ -106,8 +136,41 @@ SSAO_VECTORIZE void Frame::encode_normal_row(const float* rotation, float v, int
   }
 }
 
+// Hit k + 2 of a row, after the row's visible depths: planar, checked to lie behind the hit
+// before it, the facing folded into the sign. Without a facing image the hits are taken to
+// alternate: the 2nd a back face, the 3rd a front face, ...
+void Frame::layer_row(const FrameInputs& in, int k, int x0, int count, int y, float limit) {
+  float* row = layers_.data() + size_t(k) * pixel_count() + index(x0, y);
+  const float* before = k == 0 ? depth_.data() + index(x0, y) : row - pixel_count();
+  for (int i = 0; i < count; ++i) row[i] = in.layers[k].pixel(x0 + i, y)[0];
+  depth_row(row, x0, count, float(y) + 0.5f, in.radial_depth, limit);
+  const bool alternating_back = k % 2 == 0;
+  for (int i = 0; i < count; ++i) {
+    const float previous = std::fabs(before[i]);
+    if (depth_[index(x0 + i, y)] == kBackground) {  // a background pixel has no hits
+      row[i] = kBackground;
+      continue;
+    }
+    if (row[i] != kBackground && !(row[i] >= previous * (1.0f - kLayerOrderTolerance))) {
+      const auto name = [](int layer) {
+        return layer == 1 ? std::string("depth") : "depth" + std::to_string(layer);
+      };
+      throw_invalid_argument(
+          "image '" + name(k + 2) + "' at pixel (" + std::to_string(x0 + i) + ", " +
+          std::to_string(y) + ") is nearer than '" + name(k + 1) + "' (" +
+          (previous == kBackground ? std::string("no hit") : std::to_string(previous)) +
+          " planar): extra depth layers must be the hits behind the visible surface, in order");
+    }
+    const float depth = std::max(row[i], previous);
+    const bool back =
+        in.facing[k].attached() ? in.facing[k].pixel(x0 + i, y)[0] >= 0.5f : alternating_back;
+    row[i] = back && depth != kBackground ? -depth : depth;
+  }
+}
+
 void Frame::downsample(const Frame& full, TilePool& pool, Progress& progress) {
-  reset(full.camera().coarser(2), (full.width() + 1) / 2, (full.height() + 1) / 2);
+  reset(full.camera().coarser(2), (full.width() + 1) / 2, (full.height() + 1) / 2,
+        full.extra_layers());
   pool.for_each_tile(width_, height_, progress, [&](const Tile& t) {
     for (int y = t.y0; y < t.y1; ++y) {
       for (int x = t.x0; x < t.x1; ++x) {
@@ -125,6 +188,11 @@ void Frame::downsample(const Frame& full, TilePool& pool, Progress& progress) {
         }
         depth_[index(x, y)] = nearest;
         normal_[index(x, y)] = full.normal_[best];
+        for (int k = 0; k < extra_layers_; ++k) {
+          layers_[size_t(k) * pixel_count() + index(x, y)] =
+              nearest == kBackground ? kBackground
+                                     : full.layers_[size_t(k) * full.pixel_count() + best];
+        }
       }
     }
   });

@@ -17,9 +17,17 @@
 
 namespace ssao {
 
+// Extra depth layers: the 2nd, 3rd, ... surface hit along each pixel's ray (ssao.h "depth2").
+constexpr int kMaxExtraLayers = 4;
+
 struct FrameInputs {
   ImageView depth;
   ImageView normal;  // optional (data == nullptr: reconstruct from depth)
+  // layers[k] is hit k + 2, in the depth image's convention; facing[k] optional (channel 0,
+  // >= 0.5: a back face). The first extra_layers are attached.
+  ImageView layers[kMaxExtraLayers];
+  ImageView facing[kMaxExtraLayers];
+  int extra_layers = 0;
   bool radial_depth = false;
   bool world_normals = true;
   double camera_to_world[16] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
@@ -64,7 +72,7 @@ class Frame {
   Frame() = default;
   // Sizes the planes for a frame (keeping their memory when the size is unchanged, so a job
   // that runs frame after frame allocates once).
-  void reset(const CameraModel& camera, int width, int height);
+  void reset(const CameraModel& camera, int width, int height, int extra_layers = 0);
 
   // Fills the depth plane, then the normals (from the normal image or reconstructed from depth).
   void build(const FrameInputs& in, TilePool& pool, Progress& progress);
@@ -92,16 +100,33 @@ class Frame {
   // Whether rows [y0, y1) x columns [x0, x1) show any geometry (false: all sky).
   bool has_geometry(int x0, int y0, int x1, int y1) const;
 
+  // Extra depth layers: extra_layers() planes of pixel_count() floats, hit k + 2 in plane k:
+  // the planar depth, negated on a back face, +inf where the ray has no such hit (and on
+  // background pixels). Hits are in order along the ray.
+  int extra_layers() const { return extra_layers_; }
+  const float* layer_planes() const { return layers_.data(); }
+  size_t pixel_count() const { return size_t(width_) * size_t(height_); }
+  // Where a point at planar depth `depth` on pixel (x, y)'s ray stands among the surfaces the
+  // ray crosses: returns the depth of the front face it lies behind (the entry into a solid),
+  // +inf when it is in front of the visible surface or in free space behind a back face.
+  // `closed`: a back face follows the point on the ray, so the point is inside the solid; else
+  // nothing closes it and the caller assumes a thickness. Without extra layers: the visible
+  // surface's depth (closed = false) when the point is behind it.
+  float solid_entry(int x, int y, float depth, bool& closed) const;
+
  private:
   Vec3 reconstructed_normal(int x, int y) const;
   void depth_row(float* depth, int x0, int count, float v, bool radial, float limit) const;
   void encode_normal_row(const float* rotation, float v, int x0, int count, const float* nx,
                          const float* ny, const float* nz, uint32_t* usable, uint32_t* out) const;
 
+  void layer_row(const FrameInputs& in, int k, int x0, int count, int y, float limit);
+
   CameraModel camera_{CameraParams{}, 1, 1};
-  int width_ = 0, height_ = 0;
+  int width_ = 0, height_ = 0, extra_layers_ = 0;
   std::vector<float> depth_;
   std::vector<uint32_t> normal_;
+  std::vector<float> layers_;
 };
 
 }  // namespace ssao

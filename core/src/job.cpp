@@ -18,12 +18,16 @@
 namespace ssao {
 namespace {
 
-struct ImageRule {
-  const char* name;
-  int min_channels, max_channels;
-};
-constexpr ImageRule kImageRules[] = {{"depth", 1, 4},   {"normal", 3, 4}, {"beauty", 1, 4},
-                                     {"ambient", 1, 4}, {"ao", 1, 4},     {"composite", 1, 4}};
+// Images "depth2" ... "depth5" and "facing2" ... "facing5": the number after the prefix (2 to
+// kMaxExtraLayers + 1), 0 for any other name.
+int layer_number(const char* name, const char* prefix) {
+  const size_t length = std::strlen(prefix);
+  if (std::strncmp(name, prefix, length) != 0 || name[length] == '\0' || name[length + 1] != '\0') {
+    return 0;
+  }
+  const int number = name[length] - '0';
+  return number >= 2 && number <= kMaxExtraLayers + 1 ? number : 0;
+}
 
 CameraParams camera_params(const ParamValues& v) {
   CameraParams c;
@@ -172,29 +176,24 @@ double Job::auto_radius() const {
 void Job::set_image(const char* name, float* data, int width, int height, int channels,
                     std::ptrdiff_t pixel_stride, std::ptrdiff_t row_stride) {
   if (name == nullptr) throw_invalid_argument("image name is NULL");
-  const ImageRule* rule = nullptr;
-  for (const ImageRule& r : kImageRules) {
-    if (std::strcmp(r.name, name) == 0) rule = &r;
-  }
-  if (rule == nullptr) {
+  ImageView* slot = image_slot(name);
+  if (slot == nullptr) {
     throw_invalid_argument(std::string("unknown image '") + name +
-                           "' (expected depth, normal, beauty, ambient, ao or composite)");
+                           "' (expected depth, normal, beauty, ambient, ao, composite, depth2 to "
+                           "depth" +
+                           std::to_string(kMaxExtraLayers + 1) + " or facing2 to facing" +
+                           std::to_string(kMaxExtraLayers + 1) + ")");
   }
-  ImageView* slot = std::strcmp(name, "depth") == 0     ? &depth_
-                    : std::strcmp(name, "normal") == 0  ? &normal_
-                    : std::strcmp(name, "beauty") == 0  ? &beauty_
-                    : std::strcmp(name, "ambient") == 0 ? &ambient_
-                    : std::strcmp(name, "ao") == 0      ? &ao_out_
-                                                        : &composite_out_;
+  const int min_channels = slot == &normal_ ? 3 : 1, max_channels = 4;
   if (data == nullptr) {
     *slot = ImageView{};
     return;
   }
   const std::string what = std::string("image '") + name + "': ";
   if (width < 0 || height < 0) throw_invalid_argument(what + "negative width or height");
-  if (channels < rule->min_channels || channels > rule->max_channels) {
-    throw_invalid_argument(what + "needs " + std::to_string(rule->min_channels) + " to " +
-                           std::to_string(rule->max_channels) + " channels, got " +
+  if (channels < min_channels || channels > max_channels) {
+    throw_invalid_argument(what + "needs " + std::to_string(min_channels) + " to " +
+                           std::to_string(max_channels) + " channels, got " +
                            std::to_string(channels));
   }
   const std::ptrdiff_t pixel_bytes = std::ptrdiff_t(channels) * std::ptrdiff_t(sizeof(float));
@@ -234,6 +233,24 @@ void Job::set_image(const char* name, float* data, int width, int height, int ch
   *slot = ImageView{data, width, height, channels, pixel_stride, row_stride};
 }
 
+ImageView* Job::image_slot(const char* name) {
+  const std::pair<const char*, ImageView*> named[] = {
+      {"depth", &depth_},     {"normal", &normal_}, {"beauty", &beauty_},
+      {"ambient", &ambient_}, {"ao", &ao_out_},     {"composite", &composite_out_}};
+  for (const auto& [image, slot] : named) {
+    if (std::strcmp(name, image) == 0) return slot;
+  }
+  if (const int n = layer_number(name, "depth")) return &layers_[n - 2];
+  if (const int n = layer_number(name, "facing")) return &facing_[n - 2];
+  return nullptr;
+}
+
+int Job::extra_layers() const {
+  int count = 0;
+  while (count < kMaxExtraLayers && layers_[count].attached()) ++count;
+  return count;
+}
+
 void Job::validate_images() const {
   if (!depth_.attached()) throw_invalid_operation("no depth image: attach one with set_image");
   if (!ao_out_.attached() && !composite_out_.attached()) {
@@ -244,15 +261,30 @@ void Job::validate_images() const {
   };
   // Input images have the depth image's size; the others, the output window's (the same
   // without a window).
-  const std::pair<const char*, const ImageView*> inputs[] = {{"normal", &normal_}};
+  std::vector<std::pair<std::string, const ImageView*>> inputs = {{"normal", &normal_}};
+  const int layers = extra_layers();
+  for (int k = 0; k < kMaxExtraLayers; ++k) {
+    const std::string number = std::to_string(k + 2);
+    if (k >= layers && layers_[k].attached()) {
+      throw_invalid_argument("image 'depth" + number + "' is attached without 'depth" +
+                             std::to_string(k + 1) +
+                             "': extra depth layers are the hits in order, without a gap");
+    }
+    if (facing_[k].attached() && !layers_[k].attached()) {
+      throw_invalid_argument("image 'facing" + number + "' is attached without 'depth" + number +
+                             "'");
+    }
+    inputs.push_back({"depth" + number, &layers_[k]});
+    inputs.push_back({"facing" + number, &facing_[k]});
+  }
   const std::pair<const char*, const ImageView*> outputs[] = {{"beauty", &beauty_},
                                                               {"ambient", &ambient_},
                                                               {"ao", &ao_out_},
                                                               {"composite", &composite_out_}};
   for (const auto& [name, view] : inputs) {
     if (view->attached() && (view->width != depth_.width || view->height != depth_.height)) {
-      throw_invalid_argument(std::string("image '") + name + "' is " + size(*view) +
-                             " but depth is " + size(depth_));
+      throw_invalid_argument("image '" + name + "' is " + size(*view) + " but depth is " +
+                             size(depth_));
     }
   }
   const Tile window = output_window();
@@ -301,6 +333,8 @@ void Job::run() {
   FrameInputs in;
   in.depth = depth_;
   in.normal = normal_;
+  in.extra_layers = extra_layers();
+  for (int k = 0; k < in.extra_layers; ++k) in.layers[k] = layers_[k], in.facing[k] = facing_[k];
   in.radial_depth = v.get_string("depth_kind") == "radial";
   in.world_normals = v.get_string("normal_space") == "world";
   const std::vector<double>& matrix = v.get_floats("camera_to_world");
@@ -313,7 +347,7 @@ void Job::run() {
 
   progress.set_stage(0.0, 0.05);
   Frame& frame = frame_;
-  frame.reset(camera, width, height);
+  frame.reset(camera, width, height, in.extra_layers);
   frame.build(in, tiles, progress);
 
   // The frame the variant sees: the input's, or a half-resolution copy (a quarter of the work;

@@ -50,7 +50,13 @@ class Job {
   std::unique_ptr<TilePool> pool_;
   Frame frame_, half_frame_;
   std::vector<float> visibility_;
+  // The slot an image name attaches to, nullptr for an unknown name.
+  ImageView* image_slot(const char* name);
+  // How many extra depth layers are attached (depth2, depth3, ... without a gap).
+  int extra_layers() const;
+
   ImageView depth_, normal_, beauty_, ambient_, ao_out_, composite_out_;
+  ImageView layers_[kMaxExtraLayers], facing_[kMaxExtraLayers];
   bool windowed_ = false;
   int window_x_ = 0, window_y_ = 0;
   Progress::Callback progress_callback_ = nullptr;

@@ -313,13 +313,19 @@ struct PreparedFrame {
 
 // A corner (two walls) on a floor: creases, silhouettes and open floor in one frame. 101 pixels
 // wide, so rows end in a partial vector on every SIMD width.
-void prepare(PreparedFrame& out, const Camera& cam, const char* variant) {
+// With `layers`, a box floats in front of the corner and the frame gets the 2nd and 3rd hits:
+// `facing` says whether their facing images are given or taken to alternate.
+void prepare(PreparedFrame& out, const Camera& cam, const char* variant, bool layers = false,
+             bool facing = true) {
   Camera c = cam;
   c.width = 101;
   c.height = 67;
-  Scene s = ray_cast(
-      c, {{{{0, -1.0, 0}, {0, 1, 0}}},
-          {{{0.3, 0, -6}, normalized({1, 0, 1})}, {{0.3, 0, -6}, normalized({-1, 0, 1})}}});
+  std::vector<Solid> solids = {
+      {{{0, -1.0, 0}, {0, 1, 0}}},
+      {{{0.3, 0, -6}, normalized({1, 0, 1})}, {{0.3, 0, -6}, normalized({-1, 0, 1})}}};
+  if (layers) solids.push_back(box({-0.9, -0.8, -5.2}, {-0.1, 0.2, -4.6}));
+  static Scene s;  // the frame's images must outlive build(): kept until the next prepare()
+  s = ray_cast(c, solids);
   out.values.set_string("variant", variant);
   out.values.set_string("camera_type", c.ortho ? "ORTHO" : "PERSP");
   out.values.set_float("lens", c.lens);
@@ -330,9 +336,16 @@ void prepare(PreparedFrame& out, const Camera& cam, const char* variant) {
   in.depth = {s.depth.data(), s.width, s.height, 1, 4, 4 * std::ptrdiff_t(s.width)};
   in.normal = {s.normal.data(), s.width, s.height, 3, 12, 12 * std::ptrdiff_t(s.width)};
   in.world_normals = false;
+  for (int k = 0; layers && k < 2; ++k) {
+    in.layers[k] = {s.layer[k].data(), s.width, s.height, 1, 4, 4 * std::ptrdiff_t(s.width)};
+    if (facing) {
+      in.facing[k] = {s.facing[k].data(), s.width, s.height, 1, 4, 4 * std::ptrdiff_t(s.width)};
+    }
+  }
+  in.extra_layers = layers ? 2 : 0;
   ssao::TilePool pool(2);
   ssao::Progress progress(nullptr, nullptr);
-  out.frame.reset(camera_model(c, s.width, s.height), s.width, s.height);
+  out.frame.reset(camera_model(c, s.width, s.height), s.width, s.height, in.extra_layers);
   out.frame.build(in, pool, progress);
 }
 
@@ -355,10 +368,20 @@ std::vector<ssao::Tile> whole(const ssao::Frame& f) { return {{0, 0, f.width(), 
 }  // namespace
 
 TEST(FastPath, EveryVariantMatchesItsScalarReference) {
-  for (const ssao::VariantInfo& info : ssao::variant_registry()) {
+  struct Case {
+    const char* name;
+    bool layers, facing;
+  };
+  std::vector<Case> cases;
+  for (const ssao::VariantInfo& info : ssao::variant_registry())
+    cases.push_back({info.name, false, false});
+  // The variants that read extra depth layers, with and without facing images.
+  cases.push_back({"hemisphere", true, true});
+  cases.push_back({"hemisphere", true, false});
+  for (const Case& info : cases) {
     for (const Camera& cam : {Camera{}, Camera{true}}) {
       PreparedFrame p;
-      prepare(p, cam, info.name);
+      prepare(p, cam, info.name, info.layers, info.facing);
       const auto fast = estimate(p, false, whole(p.frame));
       const auto reference = estimate(p, true, whole(p.frame));
       size_t differ = 0, geometry = 0;
@@ -370,8 +393,10 @@ TEST(FastPath, EveryVariantMatchesItsScalarReference) {
         differ += d > 1e-3 ? 1 : 0;
         geometry += std::isfinite(p.frame.depth_plane()[i]) ? 1 : 0;
       }
-      std::printf("[ measure  ] %s %s: %zu of %zu geometry pixels differ by > 1e-3, max %.5f\n",
-                  info.name, cam.ortho ? "ortho" : "persp", differ, geometry, worst);
+      std::printf("[ measure  ] %s%s %s: %zu of %zu geometry pixels differ by > 1e-3, max %.5f\n",
+                  info.name,
+                  info.layers ? (info.facing ? " +layers" : " +layers (alternating)") : "",
+                  cam.ortho ? "ortho" : "persp", differ, geometry, worst);
       // The fast path fuses multiply-adds and refines a reciprocal estimate: rounding can move a
       // sample across a test's threshold, which changes one direction of one pixel (measured:
       // at most a handful of pixels), or move volumetric's chords a little (measured: at most

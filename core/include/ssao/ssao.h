@@ -146,12 +146,26 @@ SSAO_API ssao_status ssao_job_get_floats(ssao_job job, const char* name, double*
  *               with "ambient", beauty - (1 - AO) x ambient (not below 0 where the beauty is
  *               not); the rest copied; needs as many channels as "beauty" (may be the beauty
  *               buffer itself)
+ *   "depth2" ... "depth5"
+ *               input, optional, channel 0 read: extra depth layers, the depth of the 2nd, 3rd,
+ *               ... surface hit along each pixel's ray, in "depth"'s convention (a background
+ *               value: no such hit). Attached in order without a gap ("depth3" needs "depth2").
+ *               A hit nearer than the one before it (by more than 0.1 %) is an error; the
+ *               layers of a background pixel are not read.
+ *   "facing2" ... "facing5"
+ *               input, optional, channel 0 read: 1 where hit k is a back face (the ray leaves a
+ *               solid), 0 where it is a front face (>= 0.5 counts as back). Without it the hits
+ *               are taken to alternate: the 2nd a back face, the 3rd a front face, ...
+ *               A sample point counts as occluded inside a solid (behind a front face and in
+ *               front of the back face that follows it); behind the last front face the ray
+ *               knows, the "thickness" rule applies as with one layer. Variants that read the
+ *               layers: "hemisphere" (docs/variants.md); the others ignore them.
  * All images of a job must have the depth image's width and height, unless an output window
  * is set (ssao_job_set_output_window). */
 SSAO_API ssao_status ssao_job_set_image(ssao_job job, const char* name, float* data, int width,
                                         int height, int channels, ptrdiff_t pixel_stride,
                                         ptrdiff_t row_stride);
-/* Overscan: the depth and normal images extend beyond the frame (a guard band rendered with the
+/* Overscan: the depth, normal and extra layer images extend beyond the frame (a guard band rendered with the
  * same camera on the same pixel grid), and the frame is the window of the outputs' size whose
  * top-left pixel is pixel (x, y) of the depth image. "beauty", "ambient", "ao" and "composite"
  * then have the window's size (all the same), the window must lie inside the depth image, and

@@ -33,9 +33,12 @@ constexpr int kLaneTable = kMaxLanes + 3;
 struct HemisphereRowArgs {
   const float* depth;       // the frame's depth plane
   const uint32_t* normals;  // the frame's packed normals
+  const float* layers;      // the frame's extra depth layers (Frame::layer_planes)
+  int extra_layers;
   int width, height;
   CameraIntrinsics camera;
   float radius, min_height_bias, thickness;
+  size_t plane;  // floats per layer plane
   int directions, steps;
   // Per row class (y & 3), per sample, x/y/z of the tangent-frame offset for kLaneTable lanes
   // starting at a pixel whose x is a multiple of 4.
@@ -159,6 +162,43 @@ void hemisphere_row(const HemisphereRowArgs& a, int y, int x0, int x1, float* ou
         const VF qyv = hn::NegMulAdd(hn::ConvertTo(df, qy), scale_v, pixel_v0) * q_scale;
         const VF qzv = hn::Neg(qd);
         const VF behind = qzv - sz;  // > 0: the visible surface is in front of the sample
+        if (a.extra_layers > 0) {
+          const auto behind_visible =
+              hn::And(hn::And(in_image, hn::Lt(qd, inf)), hn::Gt(behind, zero));
+          if (hn::AllFalse(df, behind_visible)) continue;
+          // Frame::solid_entry on the lanes: walk the hits behind the visible one until the one
+          // the sample lies in front of.
+          const VF sample_depth = hn::Neg(sz);
+          VF entry = qd;
+          auto entered = behind_visible;    // the visible surface is a front face
+          auto open = behind_visible;       // not yet placed between two hits
+          auto closed = hn::Lt(one, zero);  // all false
+          for (int layer = 0; layer < a.extra_layers; ++layer) {
+            const VF hit = hn::GatherIndex(df, a.layers + size_t(layer) * a.plane, index);
+            const VF hit_depth = hn::Abs(hit);
+            const auto back = hn::Lt(hit, zero);
+            const auto here = hn::And(open, hn::Le(sample_depth, hit_depth));
+            closed = hn::Or(closed, hn::And(here, hn::And(entered, back)));
+            const auto past = hn::AndNot(here, open);  // open lanes behind this hit
+            entry = hn::IfThenElse(past, hit_depth, entry);
+            entered = hn::Or(hn::AndNot(past, entered), hn::AndNot(back, past));
+            open = past;
+            if (hn::AllFalse(df, open)) break;
+          }
+          // Occluded by the solid entered at `entry` (inside it when a back face closes it,
+          // else within the assumed thickness), when that surface is above the tangent plane.
+          const VF entry_scale = cam.orthographic ? one : entry;
+          const VF ex = hn::MulAdd(hn::ConvertTo(df, qx), scale_u, pixel_u0) * entry_scale;
+          const VF ey = hn::NegMulAdd(hn::ConvertTo(df, qy), scale_v, pixel_v0) * entry_scale;
+          const VF entry_level = hn::MulAdd(ex, nx, hn::MulAdd(ey, ny, hn::Neg(entry) * nz));
+          const auto counts =
+              hn::And(hn::And(behind_visible, entered), hn::Gt(entry_level, plane_level));
+          const VF thick =
+              hn::Min(one, hn::Max(zero, two - (sample_depth - entry) * inv_thickness));
+          const VF weight = hn::IfThenElse(closed, one, thick);
+          blocked = hn::Max(blocked, hn::IfThenElseZero(counts, weight));
+          continue;
+        }
         const VF level = hn::MulAdd(qxv, nx, hn::MulAdd(qyv, ny, qzv * nz));
         const auto counts = hn::And(hn::And(in_image, hn::Lt(qd, inf)),
                                     hn::And(hn::Gt(behind, zero), hn::Gt(level, plane_level)));
@@ -235,17 +275,11 @@ class Hemisphere final : public Variant {
   }
 
   void estimate(const Frame& f, const Tile& t, float* visibility) const override {
-    const HemisphereRowArgs args{f.depth_plane(),
-                                 f.normal_plane(),
-                                 f.width(),
-                                 f.height(),
-                                 f.camera().intrinsics(),
-                                 radius_,
-                                 bias_ * radius_,
-                                 thickness_,
-                                 directions_,
-                                 steps_,
-                                 lane_offsets_.data()};
+    const HemisphereRowArgs args{
+        f.depth_plane(), f.normal_plane(),    f.layer_planes(),        f.extra_layers(),
+        f.width(),       f.height(),          f.camera().intrinsics(), radius_,
+        bias_ * radius_, thickness_,          f.pixel_count(),         directions_,
+        steps_,          lane_offsets_.data()};
     for (int y = t.y0; y < t.y1; ++y) {
       HWY_DYNAMIC_DISPATCH(hemisphere_row)(args, y, t.x0, t.x1, visibility + f.index(t.x0, y));
     }
@@ -274,15 +308,19 @@ class Hemisphere final : public Variant {
       bool seen = false;
       for (int step = 0; step < steps_; ++step, ++offset) {
         const Vec3 sample = p + tangent * offset->x + bitangent * offset->y + normal * offset->z;
-        bool is_geometry = false;
-        Vec3 q;
-        if (!surface_behind_sample(f, sample, is_geometry, q)) continue;
+        int qx, qy;
+        if (!pixel_of_sample(f, sample, qx, qy)) continue;
         seen = true;
-        if (!is_geometry) continue;
-        const float behind = q.z - sample.z;  // > 0: the visible surface is in front of the sample
-        if (behind <= 0.0f) continue;
+        if (!f.is_geometry(qx, qy)) continue;
+        // The surface the sample lies behind (the visible one without extra layers), if any.
+        bool closed = false;
+        const float entry = f.solid_entry(qx, qy, -sample.z, closed);
+        if (entry == Frame::kBackground) continue;
+        const Vec3 q = f.camera().view_position(float(qx) + 0.5f, float(qy) + 0.5f, entry);
         if (dot(q - p, normal) <= min_height) continue;  // at or below the tangent plane
-        blocked = std::max(blocked, thickness_weight(behind, thickness_));
+        // Inside a solid that a back face closes, or within the assumed thickness.
+        blocked =
+            std::max(blocked, closed ? 1.0f : thickness_weight(-sample.z - entry, thickness_));
       }
       if (!seen) continue;
       ++valid;

@@ -68,11 +68,19 @@ void estimate_receivers(const Frame& f, const Tile& t, float radius, float* visi
 
 // Looks up the surface seen through the pixel that view-space point s projects to. Returns false
 // when s falls outside the image (or behind a perspective camera): such a sample tells nothing.
-inline bool surface_behind_sample(const Frame& f, Vec3 s, bool& is_geometry, Vec3& surface) {
+// The pixel (qx, qy) that view-space point s projects to; false when s falls outside the image
+// (or behind a perspective camera).
+inline bool pixel_of_sample(const Frame& f, Vec3 s, int& qx, int& qy) {
   float u, v;
   if (!f.camera().project(s, u, v)) return false;
   if (!(u >= 0.0f && v >= 0.0f && u < float(f.width()) && v < float(f.height()))) return false;
-  const int qx = int(u), qy = int(v);
+  qx = int(u), qy = int(v);
+  return true;
+}
+
+inline bool surface_behind_sample(const Frame& f, Vec3 s, bool& is_geometry, Vec3& surface) {
+  int qx, qy;
+  if (!pixel_of_sample(f, s, qx, qy)) return false;
   is_geometry = f.is_geometry(qx, qy);
   if (is_geometry) surface = f.position(qx, qy);
   return true;

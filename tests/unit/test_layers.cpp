@@ -1,0 +1,295 @@
+// SPDX-License-Identifier: MIT
+// Extra depth layers ("depth2", "depth3", with "facing2", "facing3"): the 2nd and 3rd surface hits
+// along each pixel's ray. Against ray-traced AO of analytic scenes: a sphere resting on a floor
+// (the floor at the contact is occluded by the whole sphere, not only by its front shell) and a
+// thin post in front of a wall (no dark halo on the wall behind it). Bad layers are refused.
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <limits>
+#include <string>
+
+#include "analytic_scene.h"
+
+using namespace test;
+
+namespace {
+
+constexpr double kRadius = 1.0;  // the AO distance of the runs and of the ray-traced reference
+
+// Runs the default variant, with the scene's 2nd and 3rd hits (and facing) when `layers` is set.
+std::vector<float> layered_ao(Scene& s, const Camera& cam, bool layers, bool facing = true,
+                              const char* resolution = "full") {
+  return compute_ao(s, cam, kRadius, "hemisphere", true, [&](Job& j) {
+    j.set("resolution", resolution);
+    if (!layers) return;
+    j.image("depth2", s.layer[0], s.width, s.height, 1);
+    j.image("depth3", s.layer[1], s.width, s.height, 1);
+    if (facing) {
+      j.image("facing2", s.facing[0], s.width, s.height, 1);
+      j.image("facing3", s.facing[1], s.width, s.height, 1);
+    }
+  });
+}
+
+struct Error {
+  double rmse = 0, bias = 0;  // ao - reference
+  int count = 0;
+};
+
+Error error_against(const std::vector<float>& ao, const std::vector<double>& reference,
+                    const std::vector<size_t>& pixels) {
+  Error e;
+  double squared = 0, sum = 0;
+  for (size_t k = 0; k < pixels.size(); ++k) {
+    const double d = ao[pixels[k]] - reference[k];
+    squared += d * d, sum += d;
+  }
+  e.count = int(pixels.size());
+  e.rmse = std::sqrt(squared / e.count), e.bias = sum / e.count;
+  return e;
+}
+
+// A floor seen from 30 degrees above, a sphere of radius 1 resting on it in the middle of the
+// view (in view space: the floor's normal tilted towards the camera).
+struct SphereOnFloor {
+  V3 floor_normal = normalized({0, std::cos(M_PI / 6), std::sin(M_PI / 6)});
+  V3 contact{0, 0, -6};
+  std::vector<Solid> solids() const {
+    return {{{contact, floor_normal}}, polyhedral_sphere(contact + floor_normal * 1.0, 1.0)};
+  }
+};
+
+}  // namespace
+
+TEST(Layers, SphereOnAFloorOccludesTheFloorAsRayTraced) {
+  Camera cam;
+  cam.width = 160, cam.height = 120;
+  const SphereOnFloor scene;
+  const auto solids = scene.solids();
+  Scene s = ray_cast(cam, solids);
+  // Floor pixels within 1.5 radii of the contact point, away from the frame's edge: their ray-
+  // traced AO (the floor's own normal; the sphere's pixels are left out).
+  std::vector<size_t> pixels;
+  std::vector<double> reference;
+  for (int y = 8; y < s.height - 8; ++y) {
+    for (int x = 8; x < s.width - 8; ++x) {
+      const size_t i = size_t(y) * s.width + x;
+      const V3 p = s.point[i];
+      if (!std::isfinite(s.depth[i]) ||
+          std::fabs(dot(p - scene.contact, scene.floor_normal)) > 1e-6) {
+        continue;
+      }
+      const V3 along = p - scene.contact;
+      if (dot(along, along) > 1.5 * 1.5 * kRadius * kRadius) continue;
+      pixels.push_back(i);
+      reference.push_back(ray_traced_ao(solids, p, scene.floor_normal, kRadius, 256));
+    }
+  }
+  ASSERT_GT(pixels.size(), 500u);
+  const Error one = error_against(layered_ao(s, cam, false), reference, pixels);
+  const Error three = error_against(layered_ao(s, cam, true), reference, pixels);
+  const Error alternating = error_against(layered_ao(s, cam, true, false), reference, pixels);
+  const Error half = error_against(layered_ao(s, cam, true, true, "half"), reference, pixels);
+  std::printf(
+      "[ measure  ] sphere on floor, %d floor px near the contact: one layer RMSE %.4f "
+      "bias %+.4f; 3 hits RMSE %.4f bias %+.4f; without facing RMSE %.4f; half "
+      "resolution RMSE %.4f\n",
+      one.count, one.rmse, one.bias, three.rmse, three.bias, alternating.rmse, half.rmse);
+  // One layer misses the sphere's inside beyond the assumed thickness: the floor reads too light.
+  EXPECT_GT(one.bias, 0.04);
+  EXPECT_LT(three.rmse, 0.7 * one.rmse);
+  EXPECT_LT(std::fabs(three.bias), 0.5 * one.bias);
+  // Hits alternate in and out on this closed scene: facing changes nothing.
+  EXPECT_NEAR(alternating.rmse, three.rmse, 1e-6);
+  EXPECT_LT(half.rmse, 0.8 * one.rmse);
+}
+
+TEST(Layers, ThinPostCastsNoHaloOnTheWallBehindIt) {
+  Camera cam;
+  cam.width = 128, cam.height = 96;
+  // A post 0.3 wide, 1.05 in front of a wall: farther than the radius, so the wall's AO is 1.
+  const std::vector<Solid> solids = {{{{0, 0, -6}, {0, 0, 1}}},
+                                     box({-0.15, -10, -4.95}, {0.15, 10, -4.65})};
+  Scene s = ray_cast(cam, solids);
+  const auto wall_near_post = [&](int x, int y) {
+    const size_t i = size_t(y) * s.width + x;
+    return s.depth[i] > 5.9f && std::fabs(s.point[i].x) < 0.7 && y > 4 && y < s.height - 4;
+  };
+  const Stats one = stats_over(s, layered_ao(s, cam, false), wall_near_post);
+  const Stats three = stats_over(s, layered_ao(s, cam, true), wall_near_post);
+  std::printf(
+      "[ measure  ] thin post: wall within 0.7 of it (%d px): one layer mean %.4f min "
+      "%.4f; 3 hits mean %.4f min %.4f (ray-traced: 1)\n",
+      one.count, one.mean, one.min, three.mean, three.min);
+  ASSERT_GT(one.count, 200);
+  EXPECT_LT(one.min, 0.85);  // the halo the extra layers remove
+  EXPECT_GE(three.min, 0.97);
+  EXPECT_GE(three.mean, 0.995);
+}
+
+TEST(Layers, FacingTellsAnOpenSurfaceFromASolid) {
+  // A card 1 in front of a wall, made an open (one-sided) surface below: the wall behind it is
+  // its 2nd hit, a front face.
+  Camera cam;
+  cam.width = 96, cam.height = 64;
+  const std::vector<Solid> solids = {{{{0, 0, -6}, {0, 0, 1}}},
+                                     box({-0.5, -10, -5.0}, {0.5, 10, -4.9})};
+  Scene s = ray_cast(cam, solids);
+  // Drop the card's back face, as an open mesh has none: the wall becomes hit 2, a front face.
+  for (size_t i = 0; i < s.depth.size(); ++i) {
+    if (s.facing[0][i] == 1.0f && s.layer[1][i] > 5.9f) {
+      s.layer[0][i] = s.layer[1][i], s.facing[0][i] = 0.0f;
+      s.layer[1][i] = std::numeric_limits<float>::infinity(), s.facing[1][i] = 0.0f;
+    }
+  }
+  const auto wall_beside_card = [&](int x, int y) {
+    const size_t i = size_t(y) * s.width + x;
+    return s.depth[i] > 5.9f && std::fabs(s.point[i].x) < 1.0 && y > 4 && y < s.height - 4;
+  };
+  const Stats one = stats_over(s, layered_ao(s, cam, false), wall_beside_card);
+  const Stats faced = stats_over(s, layered_ao(s, cam, true, true), wall_beside_card);
+  const Stats alternating = stats_over(s, layered_ao(s, cam, true, false), wall_beside_card);
+  std::printf(
+      "[ measure  ] open card: wall beside it: one layer %.4f, facing given %.4f, "
+      "alternating %.4f\n",
+      one.mean, faced.mean, alternating.mean);
+  // With its facing, a front-facing 2nd hit leaves the card to the thickness rule, as one layer
+  // does; taken as alternating, the gap up to the wall would be the inside of a solid.
+  EXPECT_NEAR(faced.mean, one.mean, 1e-6);
+  EXPECT_LT(alternating.mean, one.mean - 0.02);
+}
+
+TEST(Layers, OverscanWithLayersEqualsTheWidenedFrameCropped) {
+  constexpr int kBand = 16;
+  Camera frame;
+  frame.width = 80, frame.height = 60;
+  Camera big_camera = frame;
+  big_camera.width += 2 * kBand, big_camera.height += 2 * kBand;
+  big_camera.sensor = frame.sensor * big_camera.width / frame.width;
+  Scene big = ray_cast(big_camera, SphereOnFloor{}.solids());
+  const auto whole = layered_ao(big, big_camera, true);
+  Job job;
+  job.camera(frame);
+  job.set("radius", kRadius);
+  job.set("resolution", "full");
+  job.set("normal_space", "camera");
+  std::vector<float> ao(size_t(frame.width) * frame.height, -1.0f);
+  job.image("depth", big.depth, big.width, big.height, 1);
+  job.image("normal", big.normal, big.width, big.height, 3);
+  job.image("depth2", big.layer[0], big.width, big.height, 1);
+  job.image("facing2", big.facing[0], big.width, big.height, 1);
+  job.image("depth3", big.layer[1], big.width, big.height, 1);
+  job.image("facing3", big.facing[1], big.width, big.height, 1);
+  job.image("ao", ao, frame.width, frame.height, 1);
+  ASSERT_EQ(ssao_job_set_output_window(job.get(), 1, kBand, kBand), SSAO_OK);
+  ASSERT_EQ(job.run(), SSAO_OK) << ssao_last_error();
+  for (int y = 0; y < frame.height; ++y) {
+    for (int x = 0; x < frame.width; ++x) {
+      ASSERT_EQ(ao[size_t(y) * frame.width + x], whole[size_t(y + kBand) * big.width + x + kBand])
+          << "pixel " << x << ", " << y;
+    }
+  }
+}
+
+// --- bad layers are refused with a message, never a wrong image ---
+
+namespace {
+
+struct SmallFrame {
+  static constexpr int kSize = 8;
+  std::vector<float> depth = std::vector<float>(kSize * kSize, 5.0f);
+  std::vector<float> behind = std::vector<float>(kSize * kSize, 6.0f);
+  std::vector<float> facing = std::vector<float>(kSize * kSize, 1.0f);
+  std::vector<float> ao = std::vector<float>(kSize * kSize, -1.0f);
+  ssao_job job = nullptr;
+  SmallFrame() {
+    EXPECT_EQ(ssao_job_create(&job), SSAO_OK);
+    attach("depth", depth);
+    attach("ao", ao);
+  }
+  ~SmallFrame() { ssao_job_destroy(job); }
+  ssao_status attach(const char* name, std::vector<float>& data, int size = kSize) {
+    return ssao_job_set_image(job, name, data.data(), size, size, 1, 0, 0);
+  }
+  // Runs and returns the status; a failed run must leave the output untouched.
+  ssao_status run() {
+    const ssao_status status = ssao_job_run(job);
+    if (status != SSAO_OK) {
+      for (float v : ao) EXPECT_EQ(v, -1.0f) << "a failed run wrote its output";
+    }
+    return status;
+  }
+};
+
+}  // namespace
+
+TEST(Layers, UnknownOrGappedLayersAreRefused) {
+  SmallFrame f;
+  EXPECT_EQ(f.attach("depth6", f.behind), SSAO_ERROR_INVALID_ARGUMENT);
+  EXPECT_EQ(f.attach("depth1", f.behind), SSAO_ERROR_INVALID_ARGUMENT);
+  EXPECT_EQ(f.attach("facing", f.facing), SSAO_ERROR_INVALID_ARGUMENT);
+  EXPECT_EQ(f.attach("depth3", f.behind), SSAO_OK);
+  EXPECT_EQ(f.run(), SSAO_ERROR_INVALID_ARGUMENT);
+  EXPECT_NE(std::string(ssao_last_error()).find("without 'depth2'"), std::string::npos)
+      << ssao_last_error();
+  ASSERT_EQ(ssao_job_set_image(f.job, "depth3", nullptr, 0, 0, 1, 0, 0), SSAO_OK);
+  EXPECT_EQ(f.attach("facing2", f.facing), SSAO_OK);
+  EXPECT_EQ(f.run(), SSAO_ERROR_INVALID_ARGUMENT);
+  EXPECT_NE(std::string(ssao_last_error()).find("'facing2' is attached without 'depth2'"),
+            std::string::npos)
+      << ssao_last_error();
+}
+
+TEST(Layers, MismatchedSizesAreRefused) {
+  SmallFrame f;
+  std::vector<float> bigger(100, 6.0f);
+  ASSERT_EQ(f.attach("depth2", bigger, 10), SSAO_OK);
+  EXPECT_EQ(f.run(), SSAO_ERROR_INVALID_ARGUMENT);
+  EXPECT_NE(std::string(ssao_last_error()).find("'depth2' is 10x10 but depth is 8x8"),
+            std::string::npos)
+      << ssao_last_error();
+  ASSERT_EQ(f.attach("depth2", f.behind), SSAO_OK);
+  ASSERT_EQ(f.attach("facing2", bigger, 10), SSAO_OK);
+  EXPECT_EQ(f.run(), SSAO_ERROR_INVALID_ARGUMENT);
+}
+
+TEST(Layers, ALayerNearerThanTheOneBeforeIsRefused) {
+  SmallFrame f;
+  ASSERT_EQ(f.attach("depth2", f.behind), SSAO_OK);
+  EXPECT_EQ(f.run(), SSAO_OK) << ssao_last_error();
+  std::fill(f.ao.begin(), f.ao.end(), -1.0f);
+  f.behind[3 * SmallFrame::kSize + 2] = 4.0f;  // in front of the visible surface at 5
+  EXPECT_EQ(f.run(), SSAO_ERROR_INVALID_ARGUMENT);
+  EXPECT_NE(std::string(ssao_last_error()).find("'depth2' at pixel (2, 3) is nearer than 'depth'"),
+            std::string::npos)
+      << ssao_last_error();
+  // Within the tolerance (two renders of one surface differ by rounding): accepted.
+  f.behind[3 * SmallFrame::kSize + 2] = 5.0f * (1.0f - 1e-4f);
+  EXPECT_EQ(f.run(), SSAO_OK) << ssao_last_error();
+  // A hit behind "no hit" is out of order too.
+  std::fill(f.ao.begin(), f.ao.end(), -1.0f);
+  std::vector<float> third(f.behind.size(), 7.0f);
+  f.behind[5] = std::numeric_limits<float>::quiet_NaN();  // NaN: no hit, as for depth
+  ASSERT_EQ(f.attach("depth3", third), SSAO_OK);
+  EXPECT_EQ(f.run(), SSAO_ERROR_INVALID_ARGUMENT);
+  EXPECT_NE(std::string(ssao_last_error())
+                .find("'depth3' at pixel (5, 0) is nearer than "
+                      "'depth2' (no hit"),
+            std::string::npos)
+      << ssao_last_error();
+  // Without the 3rd layer the NaN is just a missing 2nd hit.
+  ASSERT_EQ(ssao_job_set_image(f.job, "depth3", nullptr, 0, 0, 1, 0, 0), SSAO_OK);
+  EXPECT_EQ(f.run(), SSAO_OK) << ssao_last_error();
+  for (float v : f.ao) EXPECT_TRUE(v >= 0.0f && v <= 1.0f);
+}
+
+TEST(Layers, LayersOfBackgroundPixelsAreNotRead) {
+  SmallFrame f;
+  std::fill(f.depth.begin(), f.depth.begin() + SmallFrame::kSize, 1e10f);  // a row of sky
+  std::fill(f.behind.begin(), f.behind.begin() + SmallFrame::kSize, 3.0f);
+  ASSERT_EQ(f.attach("depth2", f.behind), SSAO_OK);
+  EXPECT_EQ(f.run(), SSAO_OK) << ssao_last_error();
+  for (int x = 0; x < SmallFrame::kSize; ++x) EXPECT_EQ(f.ao[size_t(x)], 1.0f);
+}
