@@ -31,6 +31,8 @@ struct Inputs {
   std::vector<float> depth;   // 1 channel
   std::vector<float> normal;  // 3 channels or empty
   std::vector<float> beauty;  // 3 or 4 channels or empty
+  // The 2nd, 3rd, ... hit's depth, 1 channel each, and its facing (empty when not given).
+  std::vector<std::vector<float>> layer_depth, layer_facing;
   int beauty_channels() const { return static_cast<int>(passes.beauty.size()); }
 };
 
@@ -103,6 +105,8 @@ Inputs load_inputs(const Options& options) {
   overrides.normal_channels = options.normal_channels;
   overrides.beauty_channels = options.beauty_channels;
   overrides.no_normals = options.no_normals;
+  overrides.depth_layers = options.depth_layers;
+  overrides.no_depth_layers = options.no_depth_layers;
   in.passes = ssao_io::detect_passes(in.image.channel_names, overrides, options.input);
   if (options.ao_only) in.passes.beauty.clear();
   if (!options.ao_only && in.passes.beauty.empty()) {
@@ -122,6 +126,15 @@ Inputs load_inputs(const Options& options) {
     in.beauty = ssao_io::extract_channels(
         in.image, channel_indices(in.image, in.passes.beauty, options.input));
   }
+  for (const ssao_io::DepthLayerChannels& layer : in.passes.depth_layers) {
+    in.layer_depth.push_back(ssao_io::extract_channels(
+        in.image, channel_indices(in.image, {layer.depth}, options.input)));
+    in.layer_facing.push_back(
+        layer.facing.empty()
+            ? std::vector<float>()
+            : ssao_io::extract_channels(in.image,
+                                        channel_indices(in.image, {layer.facing}, options.input)));
+  }
   in.image.pixels.clear();
   in.image.pixels.shrink_to_fit();
   return in;
@@ -131,6 +144,14 @@ void attach_images(ssao_io::Job& job, Inputs& in, Outputs& out) {
   const ssao_io::Image& image = in.image;
   job.set_image("depth", in.depth.data(), image.width, image.height, 1);
   if (!in.normal.empty()) job.set_image("normal", in.normal.data(), image.width, image.height, 3);
+  for (size_t k = 0; k < in.layer_depth.size(); ++k) {
+    const std::string hit = std::to_string(k + 2);
+    job.set_image(("depth" + hit).c_str(), in.layer_depth[k].data(), image.width, image.height, 1);
+    if (!in.layer_facing[k].empty()) {
+      job.set_image(("facing" + hit).c_str(), in.layer_facing[k].data(), image.width, image.height,
+                    1);
+    }
+  }
   // The outputs are the frame; the beauty is read in place, the frame's window of the data.
   const int w = image.frame_width, h = image.frame_height;
   job.set_output_window(image.has_overscan(), image.frame_x, image.frame_y);
@@ -228,11 +249,11 @@ void print_summary(const Options& options, const ssao_io::Job& job, const Inputs
   size_t count = 0;
   const std::string mean = mean_ao(job, in, out, count);
   std::fprintf(stderr,
-               "ssao: %s: %dx%d, variant %s, normals %s, %.1f ms, mean AO %s over "
-               "%zu geometry pixels\n",
+               "ssao: %s: %dx%d, variant %s, normals %s, depth layers %zu, %.1f ms, mean AO %s "
+               "over %zu geometry pixels\n",
                options.output.c_str(), in.image.frame_width, in.image.frame_height,
                job.settings_summary().c_str(), in.normal.empty() ? "from depth" : "from pass",
-               milliseconds, mean.c_str(), count);
+               1 + in.layer_depth.size(), milliseconds, mean.c_str(), count);
 }
 
 // Without --radius: the camera file's ao_distance, else the core's automatic rule; said on

@@ -108,6 +108,29 @@ const std::vector<FrontOption>& front_options() {
        [](Options& o, const std::string& f, const std::string& v) {
          o.beauty_channels = parse_channel_list(f, v, 3, 4);
        }},
+      {kInputOutput, "--depth-layer", nullptr, "DEPTH[:FACING]",
+       "repeatable, in hit order: the channel of the depth of the 2nd surface hit along each "
+       "pixel's ray, then the 3rd, ... (up to the 5th), each with its facing channel (1 = back "
+       "face) "
+       "if any (default <layer>.Depth2.Z with <layer>.Facing2.V, Depth3.Z, ... when present); "
+       "see docs/cli.md",
+       [](Options& o, const std::string& f, const std::string& v) {
+         const size_t colon = v.find(':');
+         const std::string depth = v.substr(0, colon);
+         const std::string facing = colon == std::string::npos ? "" : v.substr(colon + 1);
+         if (depth.empty() || (colon != std::string::npos && facing.empty())) {
+           throw UsageError(f + ": expected DEPTH_CHANNEL or DEPTH_CHANNEL:FACING_CHANNEL, got '" +
+                            v + "'");
+         }
+         if (o.depth_layers.size() == ssao_io::kMaxDepthLayers) {
+           throw UsageError(f + " is given more than " + std::to_string(ssao_io::kMaxDepthLayers) +
+                            " times: the library takes the 2nd to the 5th hit");
+         }
+         o.depth_layers.push_back({depth, facing});
+       }},
+      {kInputOutput, "--no-depth-layers", nullptr, nullptr,
+       "ignore the extra depth layers a file has (one depth layer, as without them)",
+       [](Options& o, const std::string&, const std::string&) { o.no_depth_layers = true; }},
       {kInputOutput, "--no-normals", nullptr, nullptr,
        "ignore the normal pass; reconstruct normals from depth",
        [](Options& o, const std::string&, const std::string&) { o.no_normals = true; }},
@@ -153,6 +176,9 @@ void require_complete(const Options& options) {
   if (options.camera.empty()) throw UsageError("missing the camera description: --camera CAM.json");
   if (options.no_normals && !options.normal_channels.empty()) {
     throw UsageError("--no-normals and --normal-channels contradict each other");
+  }
+  if (options.no_depth_layers && !options.depth_layers.empty()) {
+    throw UsageError("--no-depth-layers and --depth-layer contradict each other");
   }
   if (options.frames.empty() && (options.skip_existing || options.json_progress)) {
     throw UsageError("--skip-existing and --progress apply to sequences (--frames)");

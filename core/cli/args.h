@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "io/blender_passes.h"
 #include "io/param_flags.h"
 #include "ssao/ssao.h"
 
@@ -31,6 +32,9 @@ struct Options {
   std::string depth_channel;
   std::vector<std::string> normal_channels;
   std::vector<std::string> beauty_channels;
+  // --depth-layer DEPTH[:FACING], in hit order (the first names the 2nd hit).
+  std::vector<ssao_io::DepthLayerChannels> depth_layers;
+  bool no_depth_layers = false;
   std::vector<ParamSetting> params;  // in command-line order
   // Sequences: IN, -o and --camera are patterns (#, @, %04d) with --frames.
   std::vector<int> frames;  // empty: one file

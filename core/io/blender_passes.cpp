@@ -99,6 +99,19 @@ std::string choose_layer_and_depth(const std::vector<std::string>& channels,
               "; name the depth channel with --depth-channel");
 }
 
+// <layer>.Depth2.Z (with <layer>.Facing2.V when present), Depth3.Z, ... up to the first missing.
+std::vector<DepthLayerChannels> find_depth_layers(const std::vector<std::string>& channels,
+                                                  const std::string& layer) {
+  std::vector<DepthLayerChannels> found;
+  for (size_t hit = 2; hit < 2 + kMaxDepthLayers; ++hit) {
+    const std::string depth = with_layer(layer, "Depth" + std::to_string(hit) + ".Z");
+    const std::string facing = with_layer(layer, "Facing" + std::to_string(hit) + ".V");
+    if (!contains(channels, depth)) break;
+    found.push_back({depth, contains(channels, facing) ? facing : ""});
+  }
+  return found;
+}
+
 }  // namespace
 
 std::vector<std::string> layers_with_depth(const std::vector<std::string>& channels) {
@@ -132,6 +145,16 @@ PassChannels detect_passes(const std::vector<std::string>& channels, const PassO
       out.normal = find_group(channels, "Normal", {"X", "Y", "Z"});
       if (out.normal.empty()) out.normal = find_group(channels, "N", {"X", "Y", "Z"});
     }
+  }
+
+  if (!overrides.depth_layers.empty()) {
+    for (const DepthLayerChannels& named : overrides.depth_layers) {
+      require_named(channels, {named.depth}, "depth layer channel", file);
+      if (!named.facing.empty()) require_named(channels, {named.facing}, "facing channel", file);
+    }
+    out.depth_layers = overrides.depth_layers;
+  } else if (!overrides.no_depth_layers) {
+    out.depth_layers = find_depth_layers(channels, out.layer);
   }
 
   if (!overrides.beauty_channels.empty()) {

@@ -586,6 +586,107 @@ class OverscanTest(CliTestCase):
         self.assert_fails(proc, 1, "does not cover its display window")
 
 
+class DepthLayersTest(CliTestCase):
+    """Extra depth layers: the standard scene's box is a plate 0.2 thick (its back face is the
+    2nd hit), the wall behind it the 3rd. With them the gap between the plate and the wall is
+    free space, so the wall around the plate is less occluded than the one-layer thickness rule
+    makes it."""
+
+    LAYER_CHANNELS = ["ViewLayer.Depth2.Z", "ViewLayer.Facing2.V", "ViewLayer.Depth3.Z",
+                      "ViewLayer.Facing3.V"]
+
+    def layer_planes(self, base=None):
+        planes = dict(self.planes if base is None else base)
+        depth = planes["ViewLayer.Depth.Z"]
+        plate = depth == BOX_DEPTH
+        sky = depth == SKY_DEPTH
+        planes["ViewLayer.Depth2.Z"] = np.where(plate, BOX_DEPTH + 0.2, SKY_DEPTH).astype(np.float32)
+        planes["ViewLayer.Facing2.V"] = np.where(plate, 1.0, 0.0).astype(np.float32)
+        planes["ViewLayer.Depth3.Z"] = np.where(plate, WALL_DEPTH, SKY_DEPTH).astype(np.float32)
+        planes["ViewLayer.Facing3.V"] = np.zeros_like(depth)
+        for name in self.LAYER_CHANNELS:
+            planes[name][sky] = SKY_DEPTH if "Depth" in name else 0.0
+        return planes
+
+    def ring_mean(self, ao):
+        """Mean AO of the wall within 6 pixels of the plate."""
+        ring = np.zeros((HEIGHT, WIDTH), bool)
+        ring[BOX_Y[0] - 6:BOX_Y[1] + 6, BOX_X[0] - 6:BOX_X[1] + 6] = True
+        ring[BOX_Y[0]:BOX_Y[1], BOX_X[0]:BOX_X[1]] = False
+        return float(ao[ring].mean())
+
+    def run_ao(self, path, *args, output=None):
+        output = output or self.path("ao_" + os.path.basename(path))
+        proc = self.run_ssao(path, "-o", output, "--camera", self.camera, "--radius", RADIUS,
+                             "--ao-only", *args, default_paths=False)
+        self.assertEqual(proc.returncode, 0, proc.stderr)
+        return read_image(output)[1][:, :, 0], proc
+
+    def test_layers_are_found_by_name_and_change_the_ao(self):
+        layered = self.path("layered.exr")
+        write_exr(layered, self.layer_planes(), BLENDER_CHANNELS + self.LAYER_CHANNELS)
+        one, _ = self.run_ao(self.input)
+        three, proc = self.run_ao(layered)
+        self.assertIn("depth layers 3", proc.stderr)
+        self.assertGreater(self.ring_mean(three), self.ring_mean(one) + 0.02,
+                           "the gap behind the plate is free space with layers")
+        # --no-depth-layers: exactly the one-layer run.
+        ignored, proc = self.run_ao(layered, "--no-depth-layers", output=self.path("ignored.exr"))
+        self.assertIn("depth layers 1", proc.stderr)
+        np.testing.assert_array_equal(ignored, one)
+        # The same layers under other names, named with --depth-layer: the same AO.
+        planes = self.layer_planes()
+        renamed = {"hit2": planes["ViewLayer.Depth2.Z"], "back2": planes["ViewLayer.Facing2.V"],
+                   "hit3": planes["ViewLayer.Depth3.Z"]}
+        other = self.path("other_names.exr")
+        write_exr(other, {**self.planes, **renamed}, BLENDER_CHANNELS + list(renamed))
+        named, _ = self.run_ao(other, "--depth-layer", "hit2:back2", "--depth-layer", "hit3")
+        np.testing.assert_array_equal(named, three)  # hit 3 without facing: a front face, as given
+
+    def test_layers_with_overscan_in_a_sequence_chunk(self):
+        band = OverscanTest.BAND
+        for frame in (1, 2):
+            write_exr(self.path(f"shot.{frame:04d}.exr"), self.layer_planes(),
+                      BLENDER_CHANNELS + self.LAYER_CHANNELS, data_origin=(-band, -band),
+                      display_size=(WIDTH - 2 * band, HEIGHT - 2 * band))
+        camera = self.write_camera(dict(CAMERA, sensor_width=CAMERA["sensor_width"] *
+                                        (WIDTH - 2 * band) / WIDTH), "frame_camera.json")
+        proc = self.run_ssao(self.path("shot.####.exr"), "-o", self.path("ao.####.exr"),
+                             "--camera", camera, "--radius", RADIUS, "--ao-only", "--frames",
+                             "1-2", "--chunk-size", "1", "--chunk-index", "1", "--skip-existing",
+                             default_paths=False)
+        self.assertEqual(proc.returncode, 0, proc.stderr)
+        _, frame = read_image(self.path("ao.0002.exr"))
+        self.assertEqual(frame.shape[:2], (HEIGHT - 2 * band, WIDTH - 2 * band))
+        # The whole data window with layers, cropped: the same AO.
+        whole = self.path("whole.exr")
+        write_exr(whole, self.layer_planes(), BLENDER_CHANNELS + self.LAYER_CHANNELS)
+        full, _ = self.run_ao(whole)
+        np.testing.assert_allclose(frame[:, :, 0], full[band:HEIGHT - band, band:WIDTH - band],
+                                   rtol=0, atol=1e-6)
+
+    def test_bad_layers_are_refused(self):
+        layered = self.path("layered.exr")
+        write_exr(layered, self.layer_planes(), BLENDER_CHANNELS + self.LAYER_CHANNELS)
+        self.assert_fails(self.run_ssao(layered, "-o", self.output, "--camera", self.camera,
+                                        "--depth-layer", "Nope.Z", default_paths=False),
+                          1, "no channel 'Nope.Z'", "depth layer")
+        for spec in ("Depth2.Z:", ":Facing2.V"):
+            self.assert_fails(self.run_ssao("--depth-layer", spec), 2, "--depth-layer")
+        self.assert_fails(self.run_ssao("--no-depth-layers", "--depth-layer", "a"), 2,
+                          "contradict")
+        self.assert_fails(self.run_ssao(*[a for _ in range(5) for a in ("--depth-layer", "d")]),
+                          2, "more than 4")
+        # A 2nd hit in front of the visible surface: the library's message, no output.
+        planes = self.layer_planes()
+        planes["ViewLayer.Depth2.Z"][30, 30] = BOX_DEPTH - 1.0
+        wrong = self.path("wrong.exr")
+        write_exr(wrong, planes, BLENDER_CHANNELS + self.LAYER_CHANNELS)
+        self.assert_fails(self.run_ssao(wrong, "-o", self.output, "--camera", self.camera,
+                                        default_paths=False),
+                          1, "'depth2' at pixel (30, 30) is nearer than 'depth'")
+
+
 class HelpTest(CliTestCase):
 
     def test_help_lists_every_parameter(self):

@@ -165,14 +165,14 @@ SSAO_API ssao_status ssao_job_get_floats(ssao_job job, const char* name, double*
 SSAO_API ssao_status ssao_job_set_image(ssao_job job, const char* name, float* data, int width,
                                         int height, int channels, ptrdiff_t pixel_stride,
                                         ptrdiff_t row_stride);
-/* Overscan: the depth, normal and extra layer images extend beyond the frame (a guard band rendered with the
- * same camera on the same pixel grid), and the frame is the window of the outputs' size whose
- * top-left pixel is pixel (x, y) of the depth image. "beauty", "ambient", "ao" and "composite"
- * then have the window's size (all the same), the window must lie inside the depth image, and
- * the camera parameters describe the window (the frame as rendered without the band). The AO of
- * the window is computed from every pixel of the depth image: it equals a run on the whole depth
- * image with the camera widened to it, cropped. Call with enable = 0 to go back to the default:
- * every image of the depth image's size. */
+/* Overscan: the depth, normal and extra layer images extend beyond the frame (a guard band rendered
+ * with the same camera on the same pixel grid), and the frame is the window of the outputs' size
+ * whose top-left pixel is pixel (x, y) of the depth image. "beauty", "ambient", "ao" and
+ * "composite" then have the window's size (all the same), the window must lie inside the depth
+ * image, and the camera parameters describe the window (the frame as rendered without the band).
+ * The AO of the window is computed from every pixel of the depth image: it equals a run on the
+ * whole depth image with the camera widened to it, cropped. Call with enable = 0 to go back to the
+ * default: every image of the depth image's size. */
 SSAO_API ssao_status ssao_job_set_output_window(ssao_job job, int enable, int x, int y);
 /* Sets (or, with fn == NULL, clears) the progress callback. */
 SSAO_API ssao_status ssao_job_set_progress(ssao_job job, ssao_progress_fn fn, void* user);
