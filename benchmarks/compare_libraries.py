@@ -11,6 +11,9 @@ Reads Depth and Normal from a Blender multilayer EXR (as ssao_eval does), runs t
 the candidate in interleaved rounds (B C B C ...) after one untimed round each, and prints the
 median and fastest time of each, their ratio, and the largest AO difference between the two.
 --set applies to both libraries, --baseline-set / --candidate-set to one.
+--baseline-layers N / --candidate-layers N attach the scene's first N extra depth layers
+(<layer>.Depth2.Z with .Facing2.V, ..., as scripts/blender/render_layers.py writes them) to one
+library: with the same .so for both, the ratio is what the layers cost.
 """
 import argparse
 import json
@@ -43,7 +46,17 @@ def read_passes(path):
     depth = np.ascontiguousarray(pixels[:, :, find(["Depth.Z", "Depth.V"])])
     normal = np.ascontiguousarray(pixels[:, :, [find(["Normal.X"]), find(["Normal.Y"]),
                                                 find(["Normal.Z"])]])
-    return depth, normal
+    layers = []  # (depth, facing or None) of hits 2, 3, ... up to the first missing
+    for hit in range(2, 6):
+        depth_index = next((i for i, n in enumerate(names) if n.endswith(f"Depth{hit}.Z")), None)
+        if depth_index is None:
+            break
+        facing_index = next((i for i, n in enumerate(names) if n.endswith(f"Facing{hit}.V")),
+                            None)
+        layers.append((np.ascontiguousarray(pixels[:, :, depth_index]),
+                       None if facing_index is None
+                       else np.ascontiguousarray(pixels[:, :, facing_index])))
+    return depth, normal, layers
 
 
 def camera_parameters(path):
@@ -66,7 +79,7 @@ def parse_sets(items):
 
 
 class Runner:
-    def __init__(self, path, params, depth, normal):
+    def __init__(self, path, params, depth, normal, layers):
         self.lib = ssao_native.load_library(path)
         self.ao = np.zeros(depth.shape, np.float32)
         self.job = ssao_native.Job(self.lib)
@@ -79,6 +92,10 @@ class Runner:
             self.job.set(name, value)
         self.job.set_image("depth", depth)
         self.job.set_image("normal", normal)
+        for hit, (layer_depth, facing) in enumerate(layers, start=2):
+            self.job.set_image(f"depth{hit}", layer_depth)
+            if facing is not None:
+                self.job.set_image(f"facing{hit}", facing)
         self.job.set_image("ao", self.ao)
         self.times = []
 
@@ -101,27 +118,35 @@ def main():
     parser.add_argument("--set", action="append", default=[])
     parser.add_argument("--baseline-set", action="append", default=[])
     parser.add_argument("--candidate-set", action="append", default=[])
+    parser.add_argument("--baseline-layers", type=int, default=0, metavar="N")
+    parser.add_argument("--candidate-layers", type=int, default=0, metavar="N")
     args = parser.parse_args()
     if args.repeat < 1:
         parser.error("--repeat must be at least 1")
 
-    depth, normal = read_passes(args.scene)
+    depth, normal, layers = read_passes(args.scene)
+    for flag, count in (("--baseline-layers", args.baseline_layers),
+                        ("--candidate-layers", args.candidate_layers)):
+        if not 0 <= count <= len(layers):
+            parser.error(f"{flag} {count}: {args.scene} has {len(layers)} extra depth layers")
     common = camera_parameters(args.camera)
     common.update(radius=args.radius, threads=args.threads)
     common.update(parse_sets(args.set))
     candidate = args.candidate or os.path.join(os.path.dirname(os.path.abspath(__file__)), "..",
                                                "build", "lib", "libssao.so")
     runners = {"baseline": Runner(args.baseline, {**common, **parse_sets(args.baseline_set)},
-                                  depth, normal),
+                                  depth, normal, layers[:args.baseline_layers]),
                "candidate": Runner(candidate, {**common, **parse_sets(args.candidate_set)},
-                                   depth, normal)}
+                                   depth, normal, layers[:args.candidate_layers])}
     for r in runners.values():
         r.run(timed=False)
     for _ in range(args.repeat):
         for r in runners.values():
             r.run()
     height, width = depth.shape
-    print(f"frame {width}x{height}, threads {args.threads}, {args.repeat} interleaved rounds")
+    print(f"frame {width}x{height}, threads {args.threads}, {args.repeat} interleaved rounds, "
+          f"extra depth layers: baseline {args.baseline_layers}, "
+          f"candidate {args.candidate_layers}")
     for name, r in runners.items():
         print(f"{name:9s} median {1e3 * statistics.median(r.times):9.2f} ms  "
               f"min {1e3 * min(r.times):9.2f} ms")

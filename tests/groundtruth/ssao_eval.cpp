@@ -96,6 +96,10 @@ const char* const kUsage =
     "  --margin F           relative margin of --compare-to, in [0, 1) (default 0)\n"
     "  --write-ao OUT.exr   write the AO of M (channel AO) to OUT.exr\n"
     "  --layer NAME         view layer to read when the file has several\n"
+    "  --layers FILE        the scene's extra depth layers and guard band, as\n"
+    "                       scripts/blender/render_layers.py writes them (same camera, pixel\n"
+    "                       grid and seed); method ssao then takes layers=N (extra hits to\n"
+    "                       use, default 0) and band=G (guard band pixels, default 0)\n"
     "  --no-normals         ignore the Normal pass: every method reconstructs normals from depth\n"
     "  -h, --help           show this help\n"
     "\n"
@@ -129,6 +133,7 @@ struct Options {
   double margin = 0.0;
   std::string write_ao;
   std::string layer;
+  std::string layers_file;
   bool no_normals = false;
   bool help = false;
 };
@@ -267,6 +272,8 @@ Options parse_args(int argc, char** argv) {
       o.write_ao = value();
     } else if (arg == "--layer") {
       o.layer = value();
+    } else if (arg == "--layers") {
+      o.layers_file = value();
     } else if (arg == "--no-normals") {
       no_value();
       o.no_normals = true;
@@ -310,7 +317,44 @@ struct Scene {
   std::vector<float> truth;         // the AO pass
   std::vector<unsigned char> mask;  // pixels that are scored
   size_t scored = 0;
+  // From --layers: the same render's passes on a frame grown by `band` pixels a side (the
+  // display window at (band, band)), and its 2nd, 3rd, ... hits with their facing.
+  int band = 0;
+  std::vector<float> band_depth, band_normal;
+  std::vector<std::vector<float>> layer_depth, layer_facing;
 };
+
+// Reads --layers FILE into the scene: a data window grown by the same band on every side.
+void load_layers(const Options& o, Scene& s) {
+  ssao_io::Image image = ssao_io::read_image(o.layers_file, ssao_io::Overscan::read);
+  const int band = image.frame_x;
+  if (image.frame_width != s.width || image.frame_height != s.height || image.frame_y != band ||
+      image.width != s.width + 2 * band || image.height != s.height + 2 * band) {
+    throw ssao_io::Error("'" + o.layers_file + "' is not the scene's frame (" +
+                         std::to_string(s.width) + "x" + std::to_string(s.height) +
+                         ") with the same guard band on every side");
+  }
+  ssao_io::PassOverrides overrides;
+  overrides.layer = o.layer;
+  const ssao_io::PassChannels passes =
+      ssao_io::detect_passes(image.channel_names, overrides, o.layers_file);
+  const auto channel = [&](const std::string& name) {
+    return ssao_io::extract_channels(image, {ssao_io::require_channel(image, name, o.layers_file)});
+  };
+  s.band = band;
+  s.band_depth = channel(passes.depth);
+  if (passes.normal.size() == 3) {
+    std::vector<int> indices;
+    for (const std::string& name : passes.normal) {
+      indices.push_back(ssao_io::require_channel(image, name, o.layers_file));
+    }
+    s.band_normal = ssao_io::extract_channels(image, indices);
+  }
+  for (const ssao_io::DepthLayerChannels& layer : passes.depth_layers) {
+    s.layer_depth.push_back(channel(layer.depth));
+    s.layer_facing.push_back(layer.facing.empty() ? std::vector<float>() : channel(layer.facing));
+  }
+}
 
 Scene load_scene(const Options& o) {
   Scene s;
@@ -365,6 +409,7 @@ Scene load_scene(const Options& o) {
                          "' has no pixel to score (none with a finite depth in (0, " +
                          std::to_string(limit) + "), 0.9 x the camera's clip_end)");
   }
+  if (!o.layers_file.empty()) load_layers(o, s);
   return s;
 }
 
@@ -585,7 +630,33 @@ ReferenceSettings parse_reference_settings(const std::string& method,
 struct CoreState {
   ssao_io::Job job;
   std::vector<float> depth, normal;
+  std::vector<std::vector<float>> layer_depth, layer_facing;
 };
+
+// The window of `plane` (`channels` floats a pixel, `width` wide with a `from_band` guard band)
+// grown by `band` pixels a side; the display window's pixels come from `frame` when given.
+std::vector<float> with_band(const std::vector<float>& plane, int width, int height, int from_band,
+                             int band, int channels, const std::vector<float>* frame) {
+  const int padded_width = width + 2 * band, padded_height = height + 2 * band;
+  const int from_width = width + 2 * from_band;
+  std::vector<float> out(size_t(padded_width) * size_t(padded_height) * size_t(channels));
+  for (int y = 0; y < padded_height; ++y) {
+    for (int x = 0; x < padded_width; ++x) {
+      const int fx = x - band, fy = y - band;  // frame coordinates
+      const bool inside = fx >= 0 && fy >= 0 && fx < width && fy < height;
+      const float* src =
+          frame != nullptr && inside
+              ? frame->data() + (size_t(fy) * size_t(width) + size_t(fx)) * size_t(channels)
+              : plane.data() +
+                    (size_t(fy + from_band) * size_t(from_width) + size_t(fx + from_band)) *
+                        size_t(channels);
+      std::copy_n(src, channels,
+                  out.begin() + std::ptrdiff_t((size_t(y) * size_t(padded_width) + size_t(x)) *
+                                               size_t(channels)));
+    }
+  }
+  return out;
+}
 
 // Prepares `name` with `settings` (from `flag`). With scene == nullptr only checks the settings
 // (so that command-line mistakes are found before any file is read).
@@ -604,8 +675,25 @@ Method make_method(const std::string& name, const std::vector<Setting>& settings
     } catch (const ssao_io::CoreError&) {
       throw UsageError(std::string("--radius: ") + ssao_last_error());
     }
-    // After the camera: a --set camera parameter overrides the file.
-    for (const Setting& s : settings) set_core_param(job, table, s, flag);
+    // layers=N and band=G (with --layers) are the evaluation's; the rest are core parameters,
+    // set after the camera: a --set camera parameter overrides the file.
+    int layers = 0, band = 0;
+    for (const Setting& s : settings) {
+      const std::string where = flag + " " + s.name + "=" + s.value;
+      if (s.name == "layers") {
+        layers = static_cast<int>(parse_integer(s.value, where, 0, 4));
+      } else if (s.name == "band") {
+        band = static_cast<int>(parse_integer(s.value, where, 0, 4096));
+      } else {
+        set_core_param(job, table, s, flag);
+      }
+    }
+    if (scene != nullptr && (layers > int(scene->layer_depth.size()) || band > scene->band)) {
+      throw UsageError(flag + " layers=" + std::to_string(layers) +
+                       " band=" + std::to_string(band) + ": --layers gives " +
+                       std::to_string(scene->layer_depth.size()) + " extra layers and a " +
+                       std::to_string(scene->band) + " px band");
+    }
     std::vector<std::string> shown = {"variant=" + job.get_string("variant"),
                                       "samples=" + std::to_string(job.get_int("samples"))};
     for (const Setting& s : settings) {
@@ -618,13 +706,31 @@ Method make_method(const std::string& name, const std::vector<Setting>& settings
     if (scene == nullptr) return m;
 
     const int w = scene->width, h = scene->height;
-    state->depth = scene->depth;
-    job.set_image("depth", state->depth.data(), w, h, 1);
-    if (!scene->world_normal.empty()) {
-      state->normal = scene->world_normal;
-      job.set_image("normal", state->normal.data(), w, h, 3);
+    const int input_w = w + 2 * band, input_h = h + 2 * band;
+    const bool from_layers_file = layers > 0 || band > 0;
+    // The scene's own passes in the frame; the layers file's in the band.
+    state->depth = from_layers_file
+                       ? with_band(scene->band_depth, w, h, scene->band, band, 1, &scene->depth)
+                       : scene->depth;
+    job.set_image("depth", state->depth.data(), input_w, input_h, 1);
+    if (!scene->world_normal.empty() && (!from_layers_file || !scene->band_normal.empty())) {
+      state->normal = from_layers_file ? with_band(scene->band_normal, w, h, scene->band, band, 3,
+                                                   &scene->world_normal)
+                                       : scene->world_normal;
+      job.set_image("normal", state->normal.data(), input_w, input_h, 3);
+    }
+    for (int k = 0; k < layers; ++k) {
+      const std::string hit = std::to_string(k + 2);
+      state->layer_depth.push_back(
+          with_band(scene->layer_depth[size_t(k)], w, h, scene->band, band, 1, nullptr));
+      job.set_image("depth" + hit, state->layer_depth.back().data(), input_w, input_h, 1);
+      if (scene->layer_facing[size_t(k)].empty()) continue;
+      state->layer_facing.push_back(
+          with_band(scene->layer_facing[size_t(k)], w, h, scene->band, band, 1, nullptr));
+      job.set_image("facing" + hit, state->layer_facing.back().data(), input_w, input_h, 1);
     }
     m.ao->assign(scene->depth.size(), 0.0f);
+    job.set_output_window(band > 0, band, band);
     job.set_image("ao", m.ao->data(), w, h, 1);
     m.run = [state] { state->job.run(); };
     return m;
