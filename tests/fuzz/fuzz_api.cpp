@@ -527,6 +527,44 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     check(s == SSAO_OK, std::string("valid image '") + kImageNames[i] + "' refused");
   }
 
+  // Extra depth layers (depth2, depth3 with their facing): hostile values, or hits in order
+  // (each the one before plus a hostile distance), which must be accepted.
+  const int extra_layers =
+      in.ConsumeIntegralInRange<int>(0, 5) == 0 ? 0 : in.ConsumeIntegralInRange<int>(0, 2);
+  const bool ordered_layers = in.ConsumeBool();
+  Buffer layers[2], facings[2];
+  for (int k = 0; k < extra_layers; ++k) {
+    layers[k] = make_buffer(in, width, height, in.ConsumeIntegralInRange<int>(1, 2));
+    facings[k] = make_buffer(in, width, height, 1);
+    fill(in, filler, layers[k], Kind::depth);
+    fill(in, filler, facings[k], Kind::colour);
+    for (int y = 0; ordered_layers && y < height; ++y) {
+      for (int x = 0; x < width; ++x) {
+        const float before = *(k == 0 ? depth : layers[k - 1]).at(x, y, 0);
+        float& hit = *layers[k].at(x, y, 0);
+        hit = std::isnan(before) ? before : before + std::fabs(hit);
+      }
+    }
+    const std::string number = std::to_string(k + 2);
+    check(ssao_job_set_image(job, ("depth" + number).c_str(), layers[k].top, width, height,
+                             layers[k].channels, layers[k].given_pixel_stride,
+                             layers[k].given_row_stride) == SSAO_OK,
+          "valid depth layer refused");
+    if (in.ConsumeBool()) {
+      check(
+          ssao_job_set_image(job, ("facing" + number).c_str(), facings[k].top, width, height, 1,
+                             facings[k].given_pixel_stride, facings[k].given_row_stride) == SSAO_OK,
+          "valid facing image refused");
+    }
+  }
+
+  // Overscan: now and then the outputs are a window inside the inputs (at a hostile place).
+  if (in.ConsumeIntegralInRange<int>(0, 7) == 0) {
+    const int x = in.ConsumeIntegralInRange<int>(-2, 3), y = in.ConsumeIntegralInRange<int>(-2, 3);
+    const ssao_status s = ssao_job_set_output_window(job, 1, x, y);
+    check(s == (x < 0 || y < 0 ? SSAO_ERROR_INVALID_ARGUMENT : SSAO_OK), "set_output_window");
+  }
+
   // auto_radius: an error (no depth, no geometry) or a usable radius.
   double radius = 0.0;
   const ssao_status radius_status = ssao_job_auto_radius(job, &radius);
@@ -546,7 +584,8 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   }
   const bool compare_threads = in.ConsumeIntegralInRange<int>(0, 7) == 0;
 
-  Buffer* const everything[] = {&depth, &normal, &beauty, &ambient, &ao, &composite, &wrong};
+  Buffer* const everything[] = {&depth, &normal,    &beauty,    &ambient,    &ao,        &composite,
+                                &wrong, &layers[0], &layers[1], &facings[0], &facings[1]};
   std::vector<std::vector<uint32_t>> before;
   for (Buffer* b : everything) before.push_back(b->snapshot());
 
@@ -568,10 +607,16 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   } else if (mismatch && wrong_size) {
     check(status == SSAO_ERROR_INVALID_ARGUMENT, "an image of another size was not refused");
   } else if (!mismatch && !log.cancelled) {
+    // Refusals that valid images can get: a camera the parameters make impossible, hits out of
+    // order (unordered layers, or a sum of hostile distances rounded below the hit before), a
+    // window whose outputs do not fit.
     const std::string message = ssao_last_error();
-    check(status == SSAO_OK || (status == SSAO_ERROR_INVALID_ARGUMENT &&
-                                message.find("camera") != std::string::npos),
-          "a valid run was refused");
+    check(status == SSAO_OK ||
+              (status == SSAO_ERROR_INVALID_ARGUMENT &&
+               (message.find("camera") != std::string::npos ||
+                (extra_layers > 0 && message.find("nearer than") != std::string::npos) ||
+                message.find("output window") != std::string::npos)),
+          "a valid run was refused: " + message);
   }
 
   // Inputs are read only; a failed or cancelled run leaves every buffer as it was.
