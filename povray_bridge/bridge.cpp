@@ -38,6 +38,10 @@ constexpr float kInfinity = std::numeric_limits<float>::infinity();
 // A depth pass whose median estimated relative error exceeds this measured nothing (a good pass:
 // about 4e-4; one without fog: 1).
 constexpr double kUnusableDepthError = 0.1;
+// POV-Ray would render a size this large for hours before anything failed; each of the passes,
+// the AO buffers and the outputs hold it as float (about 64 bytes a pixel in all).
+constexpr double kMaxPixels = 8192.0 * 8192.0;
+constexpr int kMaxSide = 65536;
 
 // Progress on stdout, warnings on stderr; both silenced by --quiet.
 class Reporter {
@@ -162,17 +166,24 @@ double seconds_since(Clock::time_point start) {
 
 // Everything the AO step needs, whichever mode produced it.
 struct AoInputs {
-  int width = 0, height = 0;
+  int width = 0, height = 0;  // the frame: the beauty's and the outputs' size
+  // Guard band, pixels on every side: depth_input and normals cover the data passes'
+  // (width + 2 band) x (height + 2 band) pixels, the frame at (band, band) inside them.
+  int band = 0;
   std::vector<float> beauty;  // R, G, B, A (linear; A = 1 when the beauty has none)
   bool beauty_has_alpha = false;
-  std::vector<float> radial;   // distance from the camera; +inf on background
-  std::vector<float> planar;   // along the view axis; +inf on background
-  std::vector<float> normals;  // libssao camera space, 3 per pixel, or empty
-  bool planar_input = false;   // give libssao the planar depth (orthographic, planar files)
-  std::vector<float> ambient;  // R, G, B, 0 per pixel in the scene's working space, or empty:
-                               // AO darkens only this part of the beauty
-  double working_gamma = 1.0;  // the scene's assumed_gamma: beauty = working value ^ gamma
-  ResolvedCamera camera;
+  std::vector<float> radial;       // the frame's distance from the camera; +inf on background
+  std::vector<float> planar;       // the frame's depth along the view axis; +inf on background
+  bool planar_input = false;       // give libssao the planar depth (orthographic, planar files)
+  std::vector<float> depth_input;  // what libssao reads: planar or radial, the band included
+  std::vector<float> normals;      // libssao camera space, 3 per pixel, the band included; or empty
+  std::vector<float> ambient;      // R, G, B, 0 per pixel in the scene's working space, or empty:
+                                   // AO darkens only this part of the beauty
+  double working_gamma = 1.0;      // the scene's assumed_gamma: beauty = working value ^ gamma
+  ResolvedCamera camera;           // the frame's (libssao's camera describes the output window)
+
+  int data_width() const { return width + 2 * band; }
+  int data_height() const { return height + 2 * band; }
 };
 
 // Copies the channels R, G, B (and A) of `image` into RGBA; a grey image (Y or one channel)
@@ -201,24 +212,32 @@ void take_beauty(const ssao_io::Image& image, const std::string& path, AoInputs&
   }
 }
 
+// From `depth` (data_width() x data_height(), planar or radial): libssao's depth_input (the
+// kind in.planar_input says) and the frame's radial and planar depth. A band pixel is the frame
+// camera's ray through pixel (x - band, y - band), outside [0, W) x [0, H).
 void fill_planar_and_radial(AoInputs& in, const std::vector<float>& depth, bool depth_is_planar) {
-  const size_t count = static_cast<size_t>(in.width) * static_cast<size_t>(in.height);
-  in.radial.assign(count, kInfinity);
-  in.planar.assign(count, kInfinity);
-  for (int y = 0; y < in.height; ++y) {
-    for (int x = 0; x < in.width; ++x) {
+  const int data_width = in.data_width(), data_height = in.data_height();
+  const size_t frame_count = static_cast<size_t>(in.width) * static_cast<size_t>(in.height);
+  in.radial.assign(frame_count, kInfinity);
+  in.planar.assign(frame_count, kInfinity);
+  in.depth_input.assign(static_cast<size_t>(data_width) * static_cast<size_t>(data_height),
+                        kInfinity);
+  for (int y = 0; y < data_height; ++y) {
+    for (int x = 0; x < data_width; ++x) {
       const size_t p =
-          static_cast<size_t>(y) * static_cast<size_t>(in.width) + static_cast<size_t>(x);
+          static_cast<size_t>(y) * static_cast<size_t>(data_width) + static_cast<size_t>(x);
       const float d = depth[p];
       if (!(std::isfinite(d) && d > 0.0f)) continue;
-      const double factor = in.camera.radial_factor(x, y, in.width, in.height);
-      if (depth_is_planar) {
-        in.planar[p] = d;
-        in.radial[p] = static_cast<float>(d * factor);
-      } else {
-        in.radial[p] = d;
-        in.planar[p] = static_cast<float>(d / factor);
-      }
+      const int fx = x - in.band, fy = y - in.band;  // the frame's pixel coordinates
+      const double factor = in.camera.radial_factor(fx, fy, in.width, in.height);
+      const float planar = depth_is_planar ? d : static_cast<float>(d / factor);
+      const float radial = depth_is_planar ? static_cast<float>(d * factor) : d;
+      in.depth_input[p] = in.planar_input ? planar : radial;
+      if (fx < 0 || fy < 0 || fx >= in.width || fy >= in.height) continue;
+      const size_t f =
+          static_cast<size_t>(fy) * static_cast<size_t>(in.width) + static_cast<size_t>(fx);
+      in.planar[f] = planar;
+      in.radial[f] = radial;
     }
   }
 }
@@ -278,9 +297,13 @@ double compute_and_write(const Options& o, AoInputs& in, const Reporter& report)
   const size_t count = static_cast<size_t>(in.width) * static_cast<size_t>(in.height);
   std::vector<float> ao(count, 1.0f);
   std::vector<float> composite(count * 4, 0.0f);
-  std::vector<float>& depth = in.planar_input ? in.planar : in.radial;
-  job.set_image("depth", depth.data(), in.width, in.height, 1);
-  if (!in.normals.empty()) job.set_image("normal", in.normals.data(), in.width, in.height, 3);
+  // With a guard band, depth and normals are larger than the frame: the outputs are the window
+  // at (band, band), and the camera set above is the frame's, as libssao wants it.
+  job.set_image("depth", in.depth_input.data(), in.data_width(), in.data_height(), 1);
+  if (!in.normals.empty()) {
+    job.set_image("normal", in.normals.data(), in.data_width(), in.data_height(), 3);
+  }
+  if (in.band > 0) job.set_output_window(true, in.band, in.band);
   // In ambient mode the composite is made in the scene's working space, where the ambient term
   // adds to the rest of the light: beauty^(1/gamma) - (1 - AO) ambient, then ^gamma again.
   const bool gamma = !in.ambient.empty() && in.working_gamma != 1.0;
@@ -330,7 +353,7 @@ double compute_and_write(const Options& o, AoInputs& in, const Reporter& report)
   double sum = 0.0;
   size_t geometry = 0;
   for (size_t p = 0; p < count; ++p) {
-    if (!std::isfinite(depth[p])) continue;
+    if (!std::isfinite(in.radial[p])) continue;
     sum += ao[p];
     ++geometry;
   }
@@ -453,11 +476,19 @@ class KeepFiles {
   const Reporter& report_;
 };
 
-void print_camera(const CameraReading& reading, int width, int height) {
+void print_camera(const CameraReading& reading, int width, int height, int band) {
   std::printf("camera: %s\n  read from %s\n", reading.camera.summary().c_str(),
               reading.source.c_str());
-  std::printf("every pass is rendered with (after the scene):\n%s",
-              reading.camera.to_sdl().c_str());
+  if (band > 0) {
+    std::printf("the beauty and the ambient pass are rendered with (after the scene):\n%s",
+                reading.camera.to_sdl().c_str());
+    std::printf("the depth and normal passes, %dx%d with a %d-pixel guard band, with:\n%s",
+                width + 2 * band, height + 2 * band, band,
+                reading.camera.widened(width, height, band).to_sdl().c_str());
+  } else {
+    std::printf("every pass is rendered with (after the scene):\n%s",
+                reading.camera.to_sdl().c_str());
+  }
   ssao_io::Job job;
   reading.camera.apply_to_job(job, width, height);
   if (reading.camera.orthographic) {
@@ -479,6 +510,36 @@ struct RenderSetup {
   ScanSettings settings;
   ClockOptions clock;
 };
+
+// The guard band of the data passes (pixels per side): --overscan, else the default; none for
+// --depth-only (the frame's depth is its output). The padded passes must stay within the size
+// limits of the frame itself.
+int guard_band(const Options& o, int width, int height) {
+  if (o.depth_only) return 0;
+  auto fits = [&](int band) {
+    const long long data_width = static_cast<long long>(width) + 2LL * band;
+    const long long data_height = static_cast<long long>(height) + 2LL * band;
+    return band >= 0 && data_width <= kMaxSide && data_height <= kMaxSide &&
+           double(data_width) * double(data_height) <= kMaxPixels;
+  };
+  if (!o.overscan) {
+    // The default shrinks near the size limits rather than refusing a frame that fits.
+    int band = default_guard_band(width, height);
+    while (band > 0 && !fits(band)) --band;
+    return band;
+  }
+  const int band = *o.overscan;
+  if (!fits(band)) {
+    const long long data_width = static_cast<long long>(width) + 2LL * band;
+    const long long data_height = static_cast<long long>(height) + 2LL * band;
+    throw ssao_io::Error(
+        "--overscan " + std::to_string(band) + ": the data passes would be " +
+        std::to_string(data_width) + "x" + std::to_string(data_height) +
+        ", over povray-ssao's limit of 65536 pixels a side and 67108864 pixels (8192 x 8192); "
+        "choose a smaller band");
+  }
+  return band;
+}
 
 // One image (a still, or one frame of an animation): the passes, AO and the outputs.
 void render_image(const Options& o, const RenderSetup& setup, const AnimationFrame* frame,
@@ -503,10 +564,11 @@ void render_image(const Options& o, const RenderSetup& setup, const AnimationFra
   const SceneScan scan = scan_scene(setup.scene_path.string(), settings);
 
   const CameraReading reading = read_camera(scan, o.camera, width, height);
+  const int band = guard_band(o, width, height);
   if (o.print_camera) {
     for (const std::string& note : scan.notes) report.warning(note);
     for (const std::string& warning : reading.warnings) report.warning(warning);
-    print_camera(reading, width, height);
+    print_camera(reading, width, height, band);
     return;
   }
   report.progress("camera: %s (%s)", reading.camera.summary().c_str(), reading.source.c_str());
@@ -538,7 +600,11 @@ void render_image(const Options& o, const RenderSetup& setup, const AnimationFra
   povray.frame = frame;
   povray.keep = !o.keep.empty();
   KeepFiles keep(scratch, o.keep, report);
-  write_wrappers(scratch.path(), scene_name, reading.camera);
+  // The data passes libssao reads (depth, normals) see a band around the frame: occluders just
+  // outside it darken its edges. The beauty and the ambient pass are the frame.
+  const int data_width = width + 2 * band, data_height = height + 2 * band;
+  write_wrappers(scratch.path(), scene_name, reading.camera,
+                 band > 0 ? reading.camera.widened(width, height, band) : reading.camera);
   const std::vector<std::string> data_pass = {"+Q9", "-A", "-UA"};
 
   // What AO darkens: the ambient term when the scene has one that can be rendered apart.
@@ -565,6 +631,7 @@ void render_image(const Options& o, const RenderSetup& setup, const AnimationFra
   AoInputs in;
   in.width = width;
   in.height = height;
+  in.band = band;
   in.camera = reading.camera;
   Render beauty_render, ambient_render, normal_render;
   if (!o.depth_only) {
@@ -592,7 +659,7 @@ void render_image(const Options& o, const RenderSetup& setup, const AnimationFra
       }
     }
     normal_render =
-        povray.start("normal pass", "normals", "normals.pov", width, height, normal_pass);
+        povray.start("normal pass", "normals", "normals.pov", data_width, data_height, normal_pass);
   }
 
   // The fog distances: given, from the camera's look_at distance, else from a small pre-pass.
@@ -605,9 +672,10 @@ void render_image(const Options& o, const RenderSetup& setup, const AnimationFra
     distances = camera_distances(reading.camera.look_at_distance);
     guessed = true;
   } else {
-    const int pw = std::min(width, std::clamp(width / 8, 16, 80));
-    const int ph =
-        std::max(1, static_cast<int>(std::lround(static_cast<double>(pw) * height / width)));
+    // depth.pov's camera sees the band too: keep its aspect.
+    const int pw = std::min(data_width, std::clamp(data_width / 8, 16, 80));
+    const int ph = std::max(
+        1, static_cast<int>(std::lround(static_cast<double>(pw) * data_height / data_width)));
     report.begin("depth-range pre-pass (%dx%d)... ", pw, ph);
     std::vector<std::string> extra = data_pass;
     for (const std::string& d : fog_declares(prepass_distances())) extra.push_back(d);
@@ -631,9 +699,15 @@ void render_image(const Options& o, const RenderSetup& setup, const AnimationFra
     std::vector<std::string> extra = data_pass;
     for (const std::string& d : fog_declares(fogs)) extra.push_back(d);
     if (scan.uses_radiosity) extra.push_back("Declare=SSAODepthCheapRadiosity=1");
-    return povray.start("depth pass", "depth", "depth.pov", width, height, extra);
+    return povray.start("depth pass", "depth", "depth.pov", data_width, data_height, extra);
   };
   Render depth_render = start_depth(distances);
+  if (band > 0) {
+    report.progress("guard band %d pixels (--overscan): the depth%s pass%s %dx%d, cropped to %dx%d",
+                    band, normal_render.process ? " and normal" : "",
+                    normal_render.process ? "es are" : " is", data_width, data_height, width,
+                    height);
+  }
   report.progress("rendering %s (%dx%d) at once...",
                   o.depth_only   ? "the depth pass"
                   : ambient_pass ? (normal_render.process ? "the beauty, depth, ambient and "
@@ -652,10 +726,10 @@ void render_image(const Options& o, const RenderSetup& setup, const AnimationFra
   for (int attempt = 0;; ++attempt) {
     depth_seconds += povray.finish(depth_render);
     const ssao_io::Image image = ssao_io::read_image(depth_render.output);
-    if (image.width != width || image.height != height) {
+    if (image.width != data_width || image.height != data_height) {
       throw ssao_io::Error("POV-Ray rendered the depth pass at " + std::to_string(image.width) +
                            "x" + std::to_string(image.height) + " instead of " +
-                           std::to_string(width) + "x" + std::to_string(height));
+                           std::to_string(data_width) + "x" + std::to_string(data_height));
     }
     std::vector<float> precision;
     depth = decode_fog(image, distances, depth_render.output, &precision);
@@ -705,6 +779,7 @@ void render_image(const Options& o, const RenderSetup& setup, const AnimationFra
   // Fog depth is radial for a perspective camera and planar for an orthographic one.
   in.planar_input = reading.camera.orthographic;
   fill_planar_and_radial(in, depth, reading.camera.orthographic);
+  depth = {};
 
   if (o.depth_only) {
     const size_t count = static_cast<size_t>(width) * static_cast<size_t>(height);
@@ -797,9 +872,15 @@ void render_image(const Options& o, const RenderSetup& setup, const AnimationFra
     report.progress("  normal pass %.2f s", normal_seconds);
     const ssao_io::Image image = ssao_io::read_image(normal_render.output);
     double unit_fraction = 0.0;
+    // decode_normals reads the depth of every pixel of the image: only a pass of its size.
+    if (image.width != data_width || image.height != data_height) {
+      throw ssao_io::Error("POV-Ray rendered the normal pass at " + std::to_string(image.width) +
+                           "x" + std::to_string(image.height) + " instead of " +
+                           std::to_string(data_width) + "x" + std::to_string(data_height));
+    }
     std::vector<float> normals =
-        decode_normals(image, in.radial, normal_render.output, unit_fraction);
-    if (image.width != width || image.height != height || unit_fraction < 0.9) {
+        decode_normals(image, in.depth_input, normal_render.output, unit_fraction);
+    if (unit_fraction < 0.9) {
       char buffer[64];
       std::snprintf(buffer, sizeof buffer, "%.0f%%", 100.0 * unit_fraction);
       report.warning(std::string("the normal pass does not decode to unit normals (") + buffer +
@@ -927,14 +1008,12 @@ void run_render(const Options& o) {
     if (height == 0) height = h;
   }
   default_size(scene_folder, width, height);
-  // POV-Ray would render a size this large for hours before anything failed; each of the
-  // passes, the AO buffers and the outputs hold it as float (about 64 bytes a pixel in all).
-  constexpr double kMaxPixels = 8192.0 * 8192.0;
-  if (width > 65536 || height > 65536 || double(width) * double(height) > kMaxPixels) {
+  if (width > kMaxSide || height > kMaxSide || double(width) * double(height) > kMaxPixels) {
     throw ssao_io::Error("the image size " + std::to_string(width) + "x" + std::to_string(height) +
                          " is over povray-ssao's limit of " +
                          "67108864 pixels (8192 x 8192, about 4 GB of passes)");
   }
+  guard_band(o, width, height);  // a band too large is every frame's mistake: refuse it now
 
   // The camera, from the scene text (and its include files, found as POV-Ray finds them).
   const std::string includes = include_folder();
@@ -1057,8 +1136,8 @@ void run_post_process(const Options& o) {
     if (!(std::isfinite(d) && d > 0.0f)) d = kInfinity;
   }
   const bool depth_is_planar = planar || in.camera.orthographic;
-  fill_planar_and_radial(in, depth, depth_is_planar);
   in.planar_input = depth_is_planar;
+  fill_planar_and_radial(in, depth, depth_is_planar);
   report.progress("%dx%d, depth channel %s (%s), camera %s", in.width, in.height, channel.c_str(),
                   depth_is_planar ? "planar" : "radial", in.camera.summary().c_str());
   compute_and_write(o, in, report);

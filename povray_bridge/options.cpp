@@ -82,6 +82,17 @@ const std::vector<FrontOption>& front_options() {
          }
          o.apply_to = v;
        }},
+      {kRender, "--overscan", nullptr, "PIXELS",
+       "guard band of the data passes: the depth (and normal) pass is rendered PIXELS larger on "
+       "every side, on the same pixel grid (a wider camera), so that AO at the frame's edges "
+       "sees occluders just outside it; the beauty and the outputs keep their size. 0 turns it "
+       "off; default: 10% of the image's larger side",
+       [](Options& o, const std::string& f, const std::string& v) {
+         const int value = parse_int(f, v);
+         // Bounded again against the image size once that is known (bridge.cpp).
+         if (value < 0 || value > 65536) throw UsageError(f + " must be 0..65536, got " + v);
+         o.overscan = value;
+       }},
       {kRender, "--depth-only", nullptr, nullptr,
        "render only the depth pass (and the pre-pass, when the camera has no look_at) and "
        "write -o OUT.exr with channels Z and Radial",
@@ -280,11 +291,11 @@ void validate(const Options& o) {
     check_output_name("-o", o.output, true);
     if (o.width || o.height || !o.ini.empty() || !o.keep.empty() || o.depth_only ||
         o.fog_distances || o.print_camera || o.no_normals || !o.povray_options.empty() ||
-        o.povray != "povray" || o.apply_to != "auto") {
+        o.povray != "povray" || o.apply_to != "auto" || o.overscan) {
       throw UsageError(
           "post-process mode (--beauty, --depth) runs no povray: size, --ini, "
-          "--keep, --depth-only, --fog-distances, --print-camera, --povray, --apply-to and "
-          "POV-Ray options do not apply (it multiplies the beauty by AO)");
+          "--keep, --depth-only, --fog-distances, --print-camera, --povray, --apply-to, "
+          "--overscan and POV-Ray options do not apply (it multiplies the beauty by AO)");
     }
     const CameraOverrides& c = o.camera;
     if (c.location || c.look_at || c.right || c.up || c.sky || c.direction) {
@@ -322,6 +333,11 @@ void validate(const Options& o) {
           o.output + "'");
     }
     if (!o.exr.empty()) throw UsageError("--depth-only writes -o only; drop --exr");
+    if (o.overscan.value_or(0) > 0) {
+      throw UsageError(
+          "--depth-only writes the frame's depth and computes no AO: --overscan "
+          "does not apply");
+    }
     if (!o.params.empty()) {
       throw UsageError(o.params.front().flag + ": --depth-only computes no AO");
     }
@@ -331,6 +347,13 @@ void validate(const Options& o) {
 }
 
 }  // namespace
+
+int default_guard_band(int width, int height) {
+  // 10% of the larger side: the default radius is 10% of the view's width at the median depth,
+  // so an occluder up to one radius beyond the edge lands in the band.
+  const int larger = std::max(width, height);
+  return static_cast<int>((static_cast<long long>(larger) + 9) / 10);
+}
 
 const ssao_io::ParamSetting* Options::param(const std::string& name) const {
   const ssao_io::ParamSetting* found = nullptr;
@@ -374,8 +397,8 @@ Options parse_args(int argc, const char* const* argv, const std::vector<ssao_par
 std::string usage_text(const std::vector<ssao_param_desc>& table) {
   std::string text =
       "Usage: povray-ssao SCENE.pov -o OUT.png [+W640 +H480] [--ini FILE.ini] [--exr OUT.exr]\n"
-      "                   [--apply-to auto|ambient|beauty] [--keep DIR] [--depth-only]\n"
-      "                   [--povray PATH] [--quiet]\n"
+      "                   [--apply-to auto|ambient|beauty] [--overscan PIXELS] [--keep DIR]\n"
+      "                   [--depth-only] [--povray PATH] [--quiet]\n"
       "                   [--camera-* overrides] [AO parameters: --radius X, --samples N, ...]\n"
       "       povray-ssao --beauty IMAGE --depth DEPTH.exr [--depth-channel NAME]\n"
       "                   [--depth-kind radial|planar] (--camera-angle DEG [--camera-aspect R] |\n"
@@ -461,6 +484,12 @@ std::string usage_text(const std::vector<ssao_param_desc>& table) {
       "            read as background.\n"
       "            The estimated error of the depth is printed. Glass and mirrors give the\n"
       "            depth of their own surface; no_image objects are not seen.\n"
+      "  Band      --overscan G, default 10% of the image's larger side (rounded up; less\n"
+      "            if the padded passes would exceed the size limit): the depth and normal\n"
+      "            passes are rendered (W + 2G) x (H + 2G) with the camera's right x (W + 2G)\n"
+      "            / W and up x (H + 2G) / H, so that their inner W x H pixels trace the\n"
+      "            frame's rays; libssao reads the band as context for the frame's edges\n"
+      "            (ssao_job_set_output_window). The beauty and the ambient pass stay W x H.\n"
       "  Radius    without --radius: 10% of the view's width at the median depth\n"
       "            (orthographic: of the view's width |right|), in scene units; printed.\n"
       "  Ambient   the ambient pass sets ambient_light rgb 10000 after the scene; divided by\n"

@@ -33,6 +33,8 @@ struct Options {
   std::vector<std::string> povray_options;  // +X switches and Name=value options, in order
   std::optional<FogDistances> fog_distances;
   std::string apply_to = "auto";  // auto | ambient | beauty
+  // Guard band of the data passes, pixels per side; unset: default_guard_band().
+  std::optional<int> overscan;
   CameraOverrides camera;
 
   // Post-process mode.
@@ -52,6 +54,10 @@ struct Options {
   // The value given for a library parameter, or nullptr.
   const ssao_io::ParamSetting* param(const std::string& name) const;
 };
+
+// The guard band povray-ssao renders around a W x H frame without --overscan (docs/povray.md,
+// "Guard band", has the measurements behind it).
+int default_guard_band(int width, int height);
 
 // Parses argv. With --help or --version anywhere, only that flag is honoured. Throws UsageError
 // for anything wrong or missing, and for combinations that contradict each other.

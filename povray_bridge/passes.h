@@ -34,9 +34,11 @@ struct FogDistances {
 constexpr double kAmbientScale = 10000.0;
 
 // The wrapper files, written into `folder`: beauty.pov, depth.pov, ambient.pov and normals.pov.
-// `scene_name` is the scene's file name (POV-Ray runs in the scene's folder).
+// `scene_name` is the scene's file name (POV-Ray runs in the scene's folder). The beauty and
+// the ambient pass (composited per pixel with it) get `camera`; the data passes libssao reads
+// (depth, normals) get `data_camera`, the same camera or one widened for a guard band.
 void write_wrappers(const std::string& folder, const std::string& scene_name,
-                    const ResolvedCamera& camera);
+                    const ResolvedCamera& camera, const ResolvedCamera& data_camera);
 
 // POV-Ray's Declare= options for the fog distances (and K).
 std::vector<std::string> fog_declares(const FogDistances& distances);

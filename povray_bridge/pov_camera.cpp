@@ -722,6 +722,13 @@ double ResolvedCamera::radial_factor(int px, int py, int width, int height) cons
   return length(direction + right * x0 + up * y0) / length(direction);
 }
 
+ResolvedCamera ResolvedCamera::widened(int width, int height, int band) const {
+  ResolvedCamera wide = *this;
+  wide.right = right * ((static_cast<double>(width) + 2.0 * band) / width);
+  wide.up = up * ((static_cast<double>(height) + 2.0 * band) / height);
+  return wide;
+}
+
 CameraReading read_camera(const SceneScan& scan, const CameraOverrides& overrides, int width,
                           int height) {
   CameraReading reading;

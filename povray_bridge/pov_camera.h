@@ -61,6 +61,13 @@ struct ResolvedCamera {
   // radial distance / planar depth of pixel (px, py): 1 for orthographic cameras.
   double radial_factor(int px, int py, int width, int height) const;
 
+  // The camera of a guard band: a (W + 2 band) x (H + 2 band) image on the same pixel grid,
+  // whose inner W x H pixels trace exactly this camera's rays. Pixel i' = i + band of the wider
+  // image has x0' = (i + band + 0.5) / (W + 2 band) - 0.5 = (i + 0.5 - W / 2) / (W + 2 band),
+  // so right' = right (W + 2 band) / W gives x0' right' = x0 right (up likewise with H); the
+  // location and direction stay. The same holds for orthographic cameras (ray origins).
+  ResolvedCamera widened(int width, int height, int band) const;
+
  private:
   void set_job_camera(ssao_io::Job& job, int width, int height) const;
 };
