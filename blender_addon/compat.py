@@ -206,3 +206,34 @@ def compositor_cannot_export(scene):
         return ("Blender 4.x's GPU compositor does not run the node's inner File Output: set "
                 "Render Properties > Performance > Compositor > Device to CPU")
     return None
+
+
+def set_aov_output_name(node, name):
+    """The AOV an AOV Output shader node writes: `aov_name` in 4.0+, the node's `name` (which
+    that type redefines) before."""
+    if hasattr(node, "aov_name"):
+        node.aov_name = name
+    else:
+        node.name = name
+
+
+def render_view_layers_only(scene):
+    """Turns off a new scene's compositing (before 5.0 scene.use_nodes; in 5.x a new scene has
+    no compositing node group) and its sequencer, so that rendering it renders only its view
+    layer."""
+    if hasattr(scene, "compositing_node_group"):
+        scene.compositing_node_group = None
+    else:
+        scene.use_nodes = False
+    scene.render.use_compositing = False
+    scene.render.use_sequencer = False
+
+
+
+def layer_collection(view_layer):
+    """A view layer's layer collection tree. In 5.2 a new scene's view layer has none (None)
+    until its depsgraph is updated once; after that, collections linked later appear in it.
+    Update while the scene is empty (cheap: nothing to evaluate)."""
+    if view_layer.layer_collection is None:
+        view_layer.update()
+    return view_layer.layer_collection

@@ -9,7 +9,7 @@ import bpy
 import numpy as np
 
 from . import camera as camera_module
-from . import compat, inner_tree, ssao_native
+from . import compat, hidden_surfaces, inner_tree, ssao_native
 
 # Where exporters write (per process; $SSAO_COMPOSITOR_EXPORT_DIR or the add-on's preference
 # override it, e.g. to keep the passes for the command-line tool). Saved files carry
@@ -27,6 +27,12 @@ EEVEE_BACKGROUND_DEPTH = 65504.0
 NODE_PARAMETERS = ("variant", "radius", "quality", "resolution", "samples", "slices", "steps",
                    "bias", "thickness", "sample_clustering", "sphere_mode", "denoise", "strength",
                    "power", "remap_min", "remap_max", "seed")
+
+# The node's own settings (not library parameters): what the add-on renders for the library
+# beyond the user's passes (hidden_surfaces.py). Saved with the node's parameters.
+NODE_SETTINGS = ("hidden_surfaces", "overscan")
+# hidden_surfaces -> surface hits per pixel the helper render records.
+HITS = {'NONE': 1, 'PEELED': 3}
 
 HELPER_SCENE_PREFIX = ".SSAO recomposite "  # recomposite.py's hidden scenes
 
@@ -118,6 +124,10 @@ def read_export(path):
 
 def node_parameters(node):
     return {name: getattr(node, name) for name in NODE_PARAMETERS if hasattr(node, name)}
+
+
+def node_settings(node):
+    return {name: getattr(node, name) for name in NODE_SETTINGS if hasattr(node, name)}
 
 
 def check_parameters(node):
@@ -260,6 +270,7 @@ def compute_node(node, scene, passes):
     the inputs, the parameters or the library cannot give this frame's AO."""
     use_normals = check_inputs(node)
     check_parameters(node)
+    lib = library()  # before the helper render (library_inputs): a missing library renders none
     camera = camera_module.camera_params(scene)
     background = EEVEE_BACKGROUND_DEPTH if compat.is_eevee(scene) else \
         library_default("background_depth")
@@ -268,17 +279,19 @@ def compute_node(node, scene, passes):
         check_normals(scene, passes, min(background, camera["clip_end"] or math.inf))
     height, width = passes.shape[:2]
     rgba = np.empty((height, width, 4), np.float32)
-    with ssao_native.Job(library()) as job:
+    # Blender's rows run bottom-up, the library's top-down: flipped views read in place.
+    images, overscan = library_inputs(node, scene, passes, use_normals)
+    with ssao_native.Job(lib) as job:
         for name, value in camera.items():
             job.set(name, value)
         job.set("background_depth", background)  # the same as the Normal check's
         job.set("threads", threads(scene))
         for name, value in node_parameters(node).items():
             job.set(name, value)
-        # Blender's rows run bottom-up: flipped views read and write in place.
-        job.set_image("depth", passes[::-1, :, 3])
-        if use_normals:
-            job.set_image("normal", passes[::-1, :, 0:3])
+        for name, image in images.items():
+            job.set_image(name, image)
+        if overscan:
+            job.set_output_window(overscan, overscan)
         job.set_image("ao", rgba[::-1])
         job.run()
     image = inner_tree.ao_image(node, width, height)
@@ -288,6 +301,53 @@ def compute_node(node, scene, passes):
     # re-composites with the old AO (measured in 5.2.2).
     image.update_tag()
     return np.ascontiguousarray(rgba[::-1, :, 0])
+
+
+def library_inputs(node, scene, passes, use_normals):
+    """({library image name: array, row 0 on top}, overscan in pixels) for `passes`: the
+    user's Depth (and Normal), and, when the node asks for hidden surfaces or a guard band, the
+    helper render's layers of the scene's current frame (hidden_surfaces.py). In the band the
+    helper's depth and normal stand in for the user's; inside it the user's passes are kept."""
+    depth, normal = passes[::-1, :, 3], passes[::-1, :, 0:3]
+    hits, overscan = HITS[getattr(node, "hidden_surfaces", 'NONE')], getattr(node, "overscan", 0)
+    if hits == 1 and not overscan:
+        return {"depth": depth, **({"normal": normal} if use_normals else {})}, 0
+    layers = hidden_surfaces.render_layers(scene, hits, overscan, folder=export_dir())
+    height, width = depth.shape
+    inside = (slice(overscan, overscan + height), slice(overscan, overscan + width))
+    full_depth = layers["depth"].copy()
+    full_depth[inside] = depth
+    images = {"depth": full_depth}
+    if use_normals:
+        full_normal = layers["normal"].copy()
+        full_normal[inside] = normal
+        images["normal"] = full_normal
+    if hits > 1:
+        images.update(_extra_layers(full_depth, layers, hits))
+    return images, overscan
+
+
+def _extra_layers(depth, layers, hits):
+    """depth2.. and facing2.. behind the depth the library is given: the helper's 2nd and
+    later hits that lie behind it. Inside the frame that depth is the user's pass, which can
+    disagree with the helper's 1st hit (EEVEE's half floats, alpha cut-outs, displacement that
+    the helper's material override drops): a hit not behind it is dropped and the later ones
+    move up, so the layers stay in depth order (the library refuses a layer nearer than the
+    one before it)."""
+    behind = np.stack([layers[f"depth{k}"] for k in range(2, hits + 1)])
+    facing = np.stack([layers[f"facing{k}"] for k in range(2, hits + 1)])
+    behind = np.where(behind > depth, behind, np.float32(np.inf))
+    order = np.argsort(behind, axis=0, kind="stable")
+    behind = np.take_along_axis(behind, order, axis=0)
+    facing = np.take_along_axis(facing, order, axis=0)
+    missing = ~np.isfinite(behind)
+    behind[missing] = hidden_surfaces.BACKGROUND
+    facing[missing] = 0.0
+    images = {}
+    for k in range(2, hits + 1):
+        images[f"depth{k}"] = np.ascontiguousarray(behind[k - 2])
+        images[f"facing{k}"] = np.ascontiguousarray(facing[k - 2])
+    return images
 
 
 def compute_frame(scene, frame, since=0.0, outcome="written"):

@@ -23,7 +23,8 @@ import time
 
 import bpy
 
-from . import compat, compute, inner_tree, main_thread, recomposite, saved_form
+from . import compat, compute, hidden_surfaces, inner_tree, main_thread, recomposite, \
+    saved_form
 from .compute import report
 
 _pending_frames = []    # UI: (scene name, frame) rendered, waiting for the main-thread timer
@@ -75,11 +76,17 @@ def _remove(path):
         pass
 
 
+def _helper_rendering():
+    """The add-on's own renders (re-composite, hidden surfaces) fire the handlers too."""
+    return recomposite.is_running() or hidden_surfaces.is_running()
+
+
 @bpy.app.handlers.persistent
 def _on_render_pre(scene, *_):
     global _render_started
-    if recomposite.is_running():
+    if _helper_rendering():
         return
+    hidden_surfaces.forget(scene.name)  # a new render: the layers kept are of the last one
     if bpy.app.background or not _written_frames:  # (the UI: the animation's first frame)
         _render_started = time.time() - 1.0  # file times may be rounded to the second
     if not bpy.app.background:
@@ -103,7 +110,7 @@ def _on_render_pre(scene, *_):
 
 @bpy.app.handlers.persistent
 def _on_render_post(scene, *_):
-    if recomposite.is_running():
+    if _helper_rendering():
         return
     if not bpy.app.background:
         # The render thread: only record (_finish_rendered_frames skips scenes without nodes).
@@ -134,7 +141,7 @@ def _on_render_post(scene, *_):
 @bpy.app.handlers.persistent
 def _on_render_write(scene, *_):
     """A frame file was written, with the AO of before this frame: write it again."""
-    if recomposite.is_running():
+    if _helper_rendering():
         return
     frame = scene.frame_current
     if not bpy.app.background:
@@ -346,7 +353,7 @@ def _compositor_editor_open():
 
 def parameter_changed(node, scene):
     """A node property changed: recompute from the last export, then re-composite (UI)."""
-    if recomposite.is_running() or saved_form.is_restoring() or bpy.app.background or \
+    if _helper_rendering() or saved_form.is_restoring() or bpy.app.background or \
             scene is None:
         return
     path = inner_tree.export_path(node, scene.frame_current)
@@ -402,6 +409,7 @@ def _on_save_pre(*_):
     # that a file opened without the add-on (or before it is enabled) writes somewhere harmless
     # and, with the add-on, where it will look.
     recomposite.remove_helpers()
+    hidden_surfaces.remove_helpers()
     _each_node(_pack_and_point_at_saved_folder, "packing the AO")
     saved_form.to_group_nodes()
 

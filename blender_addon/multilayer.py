@@ -183,11 +183,13 @@ def _attribute(name, kind, value):
     return name.encode() + b"\0" + kind.encode() + b"\0" + struct.pack("<i", len(value)) + value
 
 
-def write(path, planes, attributes=None, half=False, codec="ZIP"):
+def write(path, planes, attributes=None, half=False, codec="ZIP", overscan=0):
     """Writes {channel name: (height, width) array, row 0 on top} as a single-part scanline
     EXR; `attributes` (as read() returns them) are copied but for the ones written anew. half:
     colour channels (R, G, B, A) in 16 bits, the others (depth, normals, vectors, AO's V) in 32,
-    as Blender writes a 16-bit multilayer file."""
+    as Blender writes a 16-bit multilayer file. overscan G: the planes are a guard band of G
+    pixels around the image, written as OpenEXR's overscan: a data window from (-G, -G) around
+    a display window of (width - 2G) x (height - 2G) at (0, 0)."""
     compression = CODECS.get(codec, ZIP_COMPRESSION)
     names = sorted(planes)
     height, width = planes[names[0]].shape
@@ -199,11 +201,16 @@ def write(path, planes, attributes=None, half=False, codec="ZIP"):
              for n in names}
     chlist = b"".join(n.encode() + b"\0" + struct.pack("<iB3xii", types[n], 0, 1, 1)
                       for n in names) + b"\0"
-    window = struct.pack("<4i", 0, 0, width - 1, height - 1)
+    if not 0 <= 2 * overscan < min(width, height):
+        raise ExrError(f"{path}: an overscan of {overscan} pixels does not fit {width} x {height}")
+    data_window = struct.pack("<4i", -overscan, -overscan, width - overscan - 1,
+                              height - overscan - 1)
+    display_window = struct.pack("<4i", 0, 0, width - 2 * overscan - 1,
+                                 height - 2 * overscan - 1)
     header = [_attribute("channels", "chlist", chlist),
               _attribute("compression", "compression", bytes([compression])),
-              _attribute("dataWindow", "box2i", window),
-              _attribute("displayWindow", "box2i", window),
+              _attribute("dataWindow", "box2i", data_window),
+              _attribute("displayWindow", "box2i", display_window),
               _attribute("lineOrder", "lineOrder", b"\0")]
     defaults = {"pixelAspectRatio": ("float", struct.pack("<f", 1.0)),
                 "screenWindowCenter": ("v2f", struct.pack("<2f", 0.0, 0.0)),
@@ -225,7 +232,8 @@ def write(path, planes, attributes=None, half=False, codec="ZIP"):
             packed = _zip(block)
             if len(packed) < len(block):
                 block = packed
-        chunks.append(struct.pack("<ii", row0, len(block)) + block)
+        # A chunk names its first line by its y, the data window's (-G on top).
+        chunks.append(struct.pack("<ii", row0 - overscan, len(block)) + block)
     offset = len(head) + 8 * len(chunks)
     table = []
     for chunk in chunks:

@@ -10,6 +10,9 @@ from .compute import NODE_PARAMETERS
 LIBRARY_ERROR = None
 # Variant name -> the parameters only it reads (the node hides them for other variants).
 VARIANT_PARAMETERS = {}
+# Chosen from the costs and gains measured in docs/blender.md, "Hidden surfaces and overscan".
+DEFAULT_HIDDEN_SURFACES = 'PEELED'
+DEFAULT_OVERSCAN = 64
 
 
 def _on_parameter_changed(node, context):
@@ -60,6 +63,22 @@ class CompositorNodeSSAO(bpy.types.CompositorNodeCustomGroup):
 
     ssao_id: bpy.props.StringProperty(name="Node id", options={'HIDDEN'})
     status: bpy.props.StringProperty(name="Status", options={'SKIP_SAVE'})
+    # The add-on's own settings (compute.NODE_SETTINGS): a helper render of the surfaces behind
+    # the visible ones and of a guard band (hidden_surfaces.py; costs: docs/blender.md).
+    hidden_surfaces: bpy.props.EnumProperty(
+        name="Hidden surfaces",
+        description="What the AO knows of the surfaces behind the visible ones (a helper render "
+                    "with Cycles at 1 sample per pixel, whatever the render engine)",
+        items=[('NONE', "None", "The Depth pass only: behind it, the thickness guess"),
+               ('PEELED', "Peeled", "The 2nd and 3rd surface hit along each pixel's ray, "
+                                    "and whether each is a back face")],
+        default=DEFAULT_HIDDEN_SURFACES, update=_on_parameter_changed)
+    overscan: bpy.props.IntProperty(
+        name="Overscan", subtype='PIXEL', min=0, max=4096, soft_max=256,
+        default=DEFAULT_OVERSCAN,
+        description="Guard band rendered around the frame, in pixels per side, so that "
+                    "occluders just outside the frame count (0: off; a helper render)",
+        update=_on_parameter_changed)
 
     def init(self, context):
         self.ssao_id = inner_tree.new_id()
@@ -90,6 +109,8 @@ class CompositorNodeSSAO(bpy.types.CompositorNodeCustomGroup):
         for name in self.bl_rna.properties.keys():
             if name in NODE_PARAMETERS and (name not in variant_specific or name in active):
                 layout.prop(self, name)
+        for name in compute.NODE_SETTINGS:
+            layout.prop(self, name)
         problem = context.scene and compat.compositor_cannot_export(context.scene)
         if problem:
             layout.label(text="GPU compositor: set the compositor device to CPU", icon='ERROR')

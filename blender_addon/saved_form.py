@@ -59,6 +59,7 @@ def to_group_node(node):
     settings = dict(node.get(UNAPPLIED_KEY, {}))
     settings["ssao_id"] = node.ssao_id
     settings.update(compute.node_parameters(node))
+    settings.update(compute.node_settings(node))
     group[SETTINGS_KEY] = settings
     _relink(tree, node, group)
     name = node.name

@@ -40,6 +40,10 @@ def parse_args():
     parser.add_argument("--format", choices=("auto", "OPEN_EXR_MULTILAYER"), default="auto",
                         help="output format (auto: from --output's extension)")
     parser.add_argument("--ao-pass", action="store_true", help="also render Cycles' AO pass")
+    parser.add_argument("--hidden-surfaces", choices=("NONE", "PEELED"), default=None,
+                        help="the node's hidden_surfaces (default: the node's default)")
+    parser.add_argument("--overscan", type=int, default=None,
+                        help="the node's overscan in pixels (default: the node's default)")
     parser.add_argument("--passes-dir", default=None,
                         help="also write Image, Depth, Normal (and AO) of every frame to "
                              "DIR/####.exr with a top-level File Output node")
@@ -110,6 +114,10 @@ def main():
     rl = tree.nodes.new("CompositorNodeRLayers")
     ssao = tree.nodes.new("CompositorNodeSSAO")
     ssao.radius = args.radius
+    if args.hidden_surfaces is not None:
+        ssao.hidden_surfaces = args.hidden_surfaces
+    if args.overscan is not None:
+        ssao.overscan = args.overscan
     composite, composite_input = compat.add_result_output(tree)
     viewer = tree.nodes.new("CompositorNodeViewer")
     rl.location, ssao.location = (-300, 0), (0, 0)

@@ -32,6 +32,10 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 UI_STRESS_FRAMES = int(os.environ.get("SSAO_UI_STRESS_FRAMES", "100"))
 BUILD_SCENE = os.path.join(HERE, "build_ssao_scene.py")
 CONFIG = {}
+# The node without its helper render (hidden_surfaces.py; on by default): for the tests that
+# compare the node's AO with the command-line tool's on the same exported passes, and for the
+# UI and EEVEE tests, which also run with the defaults (the *_with_hidden_surfaces_* tests).
+ONE_LAYER = ("--hidden-surfaces", "NONE", "--overscan", "0")
 
 
 def read_exr(path):
@@ -230,7 +234,8 @@ class AddonTest(unittest.TestCase):
         self.assertRegex(output, r"MENU NODE_MT_category_\w+ [1-9]")
 
     def test_render_composites_beauty_times_ao_equal_to_the_cli(self):
-        folder, ao, passes = self.render_scene("cycles", "--samples", "128", "--ao-pass")
+        folder, ao, passes = self.render_scene("cycles", "--samples", "128", "--ao-pass",
+                                               *ONE_LAYER)
         # The same passes through the command-line tool give the same AO (same library, same
         # parameters: the node's defaults are the library's).
         cli = self.cli_ao(folder, os.path.join(folder, "scene.camera.json"))
@@ -244,13 +249,133 @@ class AddonTest(unittest.TestCase):
         self.assertLess(rmse, 0.10)  # measured 0.078 at 160x90 (tests/groundtruth: 0.077)
         self.assertLess(float(ao[geometry].mean()), 0.97)
 
+    def test_hidden_surfaces_and_overscan_bring_the_ao_closer_to_cycles(self):
+        # The node's helper render (hidden_surfaces.py): the 2nd and 3rd surface hits and a
+        # guard band must bring the node's AO closer to Cycles' AO pass of the same render.
+        # Measured at 160x90, 128 spp: RMSE 0.0805 without, 0.0705 with the layers, 0.0574 with
+        # a 16 px band, 0.0422 with both (3.4, 4.3, 5.2 alike).
+        rmse = {}
+        for hidden, overscan in (("NONE", 0), ("PEELED", 0), ("NONE", 16), ("PEELED", 16)):
+            name = f"layers_{hidden}_{overscan}"
+            folder, ao, passes = self.render_scene(name, "--samples", "128", "--ao-pass",
+                                                   "--hidden-surfaces", hidden,
+                                                   "--overscan", str(overscan))
+            depth = passes["Depth.V"]
+            geometry = np.isfinite(depth) & (depth < 1e9)
+            rmse[hidden, overscan] = float(np.sqrt(np.mean(
+                (ao[geometry] - passes["AO.R"][geometry]) ** 2)))
+            print(f"\n[measure] node AO vs Cycles AO pass, hidden_surfaces={hidden} "
+                  f"overscan={overscan}: RMSE {rmse[hidden, overscan]:.4f}", file=sys.stderr)
+        self.assertLess(rmse["PEELED", 0], rmse["NONE", 0] - 0.005)
+        self.assertLess(rmse["NONE", 16], rmse["NONE", 0] - 0.01)
+        self.assertLess(rmse["PEELED", 16], rmse["NONE", 0] - 0.03)
+        self.assertLess(rmse["PEELED", 16], min(rmse["PEELED", 0], rmse["NONE", 16]))
+
+    def test_hidden_surfaces_leave_the_scene_unchanged(self):
+        # The helper render must not change the user's scene, view layers, camera or saved
+        # file; its hidden scene, camera and material stay out of the file.
+        folder = self.folder("unchanged")
+        blend = self.blender.build_scene("unchanged/scene", "--hidden-surfaces", "PEELED",
+                                         "--overscan", "8", "--camera", "ortho",
+                                         "--output", os.path.join(folder, "out_####.png"))
+        saved = os.path.join(folder, "saved.blend")
+        state = os.path.join(folder, "state_{}.json")
+        snapshot = (
+            "import bpy, json\n"
+            "def snapshot(path):\n"
+            "    s = bpy.data.scenes['Scene']; c = s.camera\n"
+            "    keys = ('type', 'lens', 'sensor_width', 'sensor_height', 'sensor_fit', "
+            "'shift_x', 'shift_y', 'ortho_scale', 'clip_start', 'clip_end')\n"
+            "    json.dump({'scenes': sorted(x.name for x in bpy.data.scenes),\n"
+            "               'objects': sorted(o.name for o in s.objects),\n"
+            "               'cameras': sorted(x.name for x in bpy.data.cameras),\n"
+            "               'materials': sorted(x.name for x in bpy.data.materials),\n"
+            "               'camera': [c.name] + [getattr(c.data, k) for k in keys] + "
+            "[list(map(list, c.matrix_world))],\n"
+            "               'layers': [(l.name, l.use, l.use_pass_z, l.use_pass_normal, "
+            "len(l.aovs), l.material_override and l.material_override.name, l.samples) "
+            "for l in s.view_layers],\n"
+            "               'render': [s.render.engine, s.render.resolution_x, "
+            "s.render.resolution_y, s.cycles.samples, s.frame_current]}, open(path, 'w'))\n")
+        self.blender.run(blend, "--python-exit-code", "1", "--python-expr", snapshot +
+                         f"snapshot({state.format('before')!r})\n"
+                         "bpy.ops.render.render(write_still=True)\n"
+                         f"snapshot({state.format('after')!r})\n"
+                         f"bpy.ops.wm.save_as_mainfile(filepath={saved!r})\n",
+                         env={"SSAO_COMPOSITOR_EXPORT_DIR": os.path.join(folder, "export")})
+        self.blender.run(saved, "--python-exit-code", "1", "--python-expr", snapshot +
+                         f"snapshot({state.format('saved')!r})\n")
+        with open(state.format("before")) as f:
+            before = json.load(f)
+        with open(state.format("after")) as f:
+            after = json.load(f)
+        with open(state.format("saved")) as f:
+            saved_state = json.load(f)
+        helpers = [name for name in after["scenes"] if name.startswith(".SSAO layers")]
+        self.assertEqual(len(helpers), 1, after["scenes"])  # the render did use the helper
+        for key in ("objects", "camera", "layers", "render"):
+            self.assertEqual(after[key], before[key], key)
+            self.assertEqual(saved_state[key], before[key], key)
+        for key in ("scenes", "cameras", "materials"):
+            self.assertEqual(saved_state[key], before[key], key)
+
+    def test_render_layers_script_writes_what_the_cli_reads(self):
+        # scripts/blender/render_layers.py without the add-on installed (it imports
+        # blender_addon/ from the repository): one multilayer EXR with the channel names the
+        # CLI detects and the guard band as a data window around the display window.
+        import OpenImageIO as oiio
+        folder = self.folder("render_layers")
+        blend = self.blender.build_scene("render_layers/scene",
+                                         "--output", os.path.join(folder, "out_####.png"))
+        out, camera = os.path.join(folder, "layers.exr"), os.path.join(folder, "camera.json")
+        script = os.path.join(HERE, "..", "..", "scripts", "blender", "render_layers.py")
+        log = self.blender.run(blend, "--python", script, "--", "--output", out,
+                               "--overscan", "8", "--camera-json", camera, addon=False)
+        self.assertIn("render_layers: wrote", log)
+        image = oiio.ImageInput.open(out)
+        spec = image.spec()
+        layer = "ViewLayer"
+        self.assertEqual(sorted(spec.channelnames), sorted(
+            [f"{layer}.Depth.Z", f"{layer}.Normal.X", f"{layer}.Normal.Y", f"{layer}.Normal.Z",
+             f"{layer}.Depth2.Z", f"{layer}.Facing2.V", f"{layer}.Depth3.Z",
+             f"{layer}.Facing3.V"]))
+        self.assertEqual((spec.full_x, spec.full_y, spec.full_width, spec.full_height),
+                         (0, 0, 160, 90))
+        self.assertEqual((spec.x, spec.y, spec.width, spec.height), (-8, -8, 176, 106))
+        pixels = image.read_image(oiio.FLOAT)
+        image.close()
+        channels = {name: pixels[:, :, i] for i, name in enumerate(spec.channelnames)}
+        depth, depth2 = channels[f"{layer}.Depth.Z"], channels[f"{layer}.Depth2.Z"]
+        hit = depth2 < 1e9
+        self.assertGreater(int(hit.sum()), 100, "some pixels have a 2nd hit")
+        self.assertTrue(np.all(depth2[hit] > depth[hit]), "the 2nd hit lies behind the 1st")
+        self.assertTrue(set(np.unique(channels[f"{layer}.Facing2.V"])) <= {0.0, 1.0})
+        with open(camera) as f:
+            self.assertEqual(json.load(f)["type"], "PERSP")
+        # The CLI reads it without flags: the layers found by name, the data window as
+        # overscan (its AO has the display window's size).
+        ao = os.path.join(folder, "ao.exr")
+        cli = subprocess.run([CONFIG["cli"], out, "--camera", camera, "--radius", "0.8",
+                              "--ao-only", "-o", ao], check=True, capture_output=True,
+                             text=True)
+        self.assertIn("depth layers 3", cli.stdout + cli.stderr)
+        self.assertEqual(read_exr(ao)["AO"].shape, (90, 160))
+
     def test_orthographic_camera(self):
-        folder, ao, _ = self.render_scene("ortho", "--camera", "ortho")
+        folder, ao, _ = self.render_scene("ortho", "--camera", "ortho", *ONE_LAYER)
         cli = self.cli_ao(folder, os.path.join(folder, "scene.camera.json"))
         np.testing.assert_allclose(ao, cli, atol=1e-5)
 
     def test_eevee(self):
-        folder, ao, passes = self.render_scene("eevee", "--engine", "eevee")
+        self.eevee("eevee", *ONE_LAYER)
+
+    def test_eevee_with_hidden_surfaces_and_overscan(self):
+        # The helper renders with Cycles (background 1e10) under EEVEE's Depth pass (65504 in
+        # 3.4, the clip end in 4.3): the sky must stay background, in the frame and in the band.
+        self.eevee("eevee_layers", "--hidden-surfaces", "PEELED", "--overscan", "8")
+
+    def eevee(self, name, *options):
+        folder, ao, passes = self.render_scene(name, "--engine", "eevee", *options)
         depth = passes["Depth.V"]
         # EEVEE's sky: 65504 (the largest half float) in Blender 3.x, the clip end in 4.2+.
         with open(os.path.join(folder, "scene.camera.json")) as f:
@@ -262,7 +387,7 @@ class AddonTest(unittest.TestCase):
 
     def test_animation_renders_every_frame_with_its_own_ao(self):
         folder = self.folder("anim")
-        blend = self.blender.build_scene("anim/scene", "--frames", "3",
+        blend = self.blender.build_scene("anim/scene", *ONE_LAYER, "--frames", "3",
                                          "--output", os.path.join(folder, "out_####.exr"),
                                          "--passes-dir", os.path.join(folder, "passes"))
         log = self.blender.run(blend, "-a", env={
@@ -331,8 +456,45 @@ class AddonTest(unittest.TestCase):
         # change: the Render Result's Composite must be its Combined x the node's AO each time
         # (scripts/blender/ui_screenshot.py measures it), with no render for the change. In
         # 5.2 this runs on its default GPU compositor.
-        folder = self.folder("ui_f12")
-        blend = self.blender.build_scene("ui_f12/scene", "--output",
+        self.ui_f12("ui_f12", *ONE_LAYER)
+
+    @unittest.skipUnless(shutil.which("xvfb-run"), "needs xvfb-run (apt-get install xvfb)")
+    def test_ui_f12_with_hidden_surfaces_and_overscan(self):
+        # The same with the helper render (hidden_surfaces.py) rendered from the main-thread
+        # timer after F12 and reused, not rendered again, by the property change.
+        self.ui_f12("ui_f12_layers", "--hidden-surfaces", "PEELED", "--overscan", "8")
+
+    @unittest.skipUnless(shutil.which("xvfb-run"), "needs xvfb-run (apt-get install xvfb)")
+    def test_ui_changing_hidden_surfaces_renders_the_helper_again(self):
+        # In the UI, F12 with the defaults (hidden surfaces and a band), then the two settings
+        # changed from the node: each change recomputes (the helper render runs inside the
+        # node's update callback, on the main thread) and the AO changes each time.
+        folder = self.folder("ui_change")
+        blend = self.blender.build_scene("ui_change/scene", "--output",
+                                         os.path.join(folder, "out_####.png"))
+        report_path = os.path.join(folder, "report.json")
+        self.blender.run_ui(blend, os.path.join(HERE, "ui_change_hidden_surfaces.py"),
+                            report_path,
+                            env={"SSAO_COMPOSITOR_EXPORT_DIR": os.path.join(folder, "export")})
+        with open(report_path) as f:
+            report = json.load(f)
+        self.assertEqual([r["step"] for r in report], ["after F12", "NONE, 0", "PEELED, 32"])
+        # The default workspace shows no compositor editor: computed, not shown (see "What the
+        # UI needs for the AO to show after F12").
+        self.assertTrue(report[0]["status"].startswith(("Frame 1: ", "AO computed")), report)
+        for r in report[1:]:
+            self.assertEqual(r["status"], "Frame 1: recomputed", report)
+        # Each assignment recomputes: F12 one helper render; then NONE (band still 64 px) one,
+        # overscan 0 none (nothing to render); then PEELED (no band) one, overscan 32 one.
+        self.assertEqual([r["helper_renders"] for r in report], [1, 2, 4], report)
+        means = [r["ao_mean"] for r in report]
+        self.assertLess(means[0], 0.97)
+        self.assertGreater(abs(means[1] - means[0]), 1e-4, report)
+        self.assertGreater(abs(means[2] - means[1]), 1e-4, report)
+
+    def ui_f12(self, name, *options):
+        folder = self.folder(name)
+        blend = self.blender.build_scene(f"{name}/scene", *options, "--output",
                                          os.path.join(folder, "out_####.png"))
         script = os.path.join(HERE, "..", "..", "scripts", "blender", "ui_screenshot.py")
         self.blender.run_ui(blend, script, "--out", os.path.join(folder, "shots"),
@@ -352,8 +514,16 @@ class AddonTest(unittest.TestCase):
         # frame must carry its own AO, the one a headless render (-a) of the same frame gets.
         # Frame 4's AO fails, with an AO of 0.5 in the node from before: its file must be the
         # beauty (before, it kept the AO the frames were composited with during the job).
-        folder = self.folder("ui_anim")
-        blend = self.blender.build_scene("ui_anim/scene", "--frames", "4",
+        self.ui_animation("ui_anim", *ONE_LAYER)
+
+    @unittest.skipUnless(shutil.which("xvfb-run"), "needs xvfb-run (apt-get install xvfb)")
+    def test_ui_animation_with_hidden_surfaces_and_overscan(self):
+        # The same with the helper render of each frame (its own camera) after the job.
+        self.ui_animation("ui_anim_layers", "--hidden-surfaces", "PEELED", "--overscan", "8")
+
+    def ui_animation(self, name, *options):
+        folder = self.folder(name)
+        blend = self.blender.build_scene(f"{name}/scene", *options, "--frames", "4",
                                          "--output", os.path.join(folder, "out_####.exr"),
                                          "--passes-dir", os.path.join(folder, "passes"))
         env = {"SSAO_COMPOSITOR_EXPORT_DIR": os.path.join(folder, "export")}
@@ -368,7 +538,7 @@ class AddonTest(unittest.TestCase):
         self.assertEqual(log.count("with AO"), 3, log)
         self.assertRegex(log, r"error: Scene frame 4 node '[^']+': written WITHOUT AO: "
                               r"ssao_job_run: simulated library failure")
-        headless = self.folder("ui_anim/headless")
+        headless = self.folder(f"{name}/headless")
         self.blender.run(blend, "-o", os.path.join(headless, "out_####"), "-e", "3", "-a", env={
             "SSAO_COMPOSITOR_EXPORT_DIR": os.path.join(headless, "export")})
         for frame, ui_ao in zip((1, 2, 3), ui_aos):
@@ -386,7 +556,7 @@ class AddonTest(unittest.TestCase):
         # be written with its own AO.
         frames = UI_STRESS_FRAMES
         folder = self.folder("ui_many")
-        blend = self.blender.build_scene("ui_many/scene", "--frames", str(frames),
+        blend = self.blender.build_scene("ui_many/scene", *ONE_LAYER, "--frames", str(frames),
                                          "--samples", "4",
                                          "--output", os.path.join(folder, "out_####.exr"),
                                          "--passes-dir", os.path.join(folder, "passes"))
@@ -519,7 +689,7 @@ class AddonTest(unittest.TestCase):
                   8: ("radius nan", "the node's property 'radius' is nan"),
                   9: ("normal pass off", "Passes > Data > Normal"),
                   10: ("depth pass off", "Passes > Data > Z")}
-        blend = self.blender.build_scene("broken/scene", "--frames", "10",
+        blend = self.blender.build_scene("broken/scene", *ONE_LAYER, "--frames", "10",
                                          "--output", os.path.join(folder, "out_####.exr"),
                                          "--passes-dir", os.path.join(folder, "passes"))
         report_path = os.path.join(folder, "report.json")

@@ -1,0 +1,110 @@
+# SPDX-License-Identifier: MIT
+"""The cost of the node's helper render (blender_addon/hidden_surfaces.py) against the beauty
+render, on the test scene (light) and on the same scene with a mesh of about 2M triangles
+(docs/blender.md, "Hidden surfaces and overscan"):
+
+    blender -b --factory-startup -P tests/blender/measure_hidden_surfaces.py -- \\
+        [--width 640 --height 360 --samples 16 --triangles 2000000 --rounds 3]
+
+Prints one `[measure]` line per case: the beauty render's time (Cycles, CPU) and the helper's
+(3 hits, with and without a guard band), medians of --rounds after one warm-up, in one Blender.
+"""
+import argparse
+import importlib
+import os
+import statistics
+import sys
+import time
+
+import bpy
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path.insert(0, os.path.join(HERE, "..", "..", "scripts", "blender"))
+sys.path.insert(0, os.path.join(HERE, "..", ".."))
+import make_reference_scene as reference  # noqa: E402
+
+hidden_surfaces = importlib.import_module("blender_addon.hidden_surfaces")
+
+
+def parse_args():
+    argv = sys.argv[sys.argv.index("--") + 1:] if "--" in sys.argv else []
+    parser = argparse.ArgumentParser()
+    parser.add_argument("--width", type=int, default=640)
+    parser.add_argument("--height", type=int, default=360)
+    parser.add_argument("--samples", type=int, default=16)
+    parser.add_argument("--triangles", type=int, default=2000000)
+    parser.add_argument("--rounds", type=int, default=3)
+    parser.add_argument("--overscan", type=int, default=32)
+    parser.add_argument("--persistent", action="store_true",
+                        help="Render Properties > Performance > Persistent Data on")
+    return parser.parse_args(argv)
+
+
+def heavy_mesh(scene, triangles):
+    """A displaced grid of about `triangles` triangles in view, behind the test objects."""
+    side = int((triangles / 2) ** 0.5)
+    bpy.ops.mesh.primitive_grid_add(x_subdivisions=side, y_subdivisions=side, size=6,
+                                    location=(0, 3, 1.5), rotation=(1.2, 0, 0))
+    grid = bpy.context.active_object
+    mesh = grid.data
+    import numpy as np
+    co = np.empty(len(mesh.vertices) * 3, np.float32)
+    mesh.vertices.foreach_get("co", co)
+    co = co.reshape(-1, 3)
+    co[:, 2] += 0.05 * np.sin(co[:, 0] * 40) * np.cos(co[:, 1] * 40)
+    mesh.vertices.foreach_set("co", co.ravel())
+    mesh.update()
+    if grid.name not in scene.objects:
+        scene.collection.objects.link(grid)
+    return sum(len(p.vertices) - 2 for p in mesh.polygons)
+
+
+def timed(function, rounds):
+    function()  # warm-up (kernels, caches)
+    times = []
+    for _ in range(rounds):
+        start = time.perf_counter()
+        function()
+        times.append(time.perf_counter() - start)
+    return statistics.median(times)
+
+
+def measure(scene, label, args):
+    beauty = timed(lambda: bpy.ops.render.render(), args.rounds)
+    results = {}
+    for hits, overscan in ((3, 0), (3, args.overscan), (1, args.overscan)):
+        def helper():
+            hidden_surfaces.forget()
+            hidden_surfaces.render_layers(scene, hits, overscan)
+        results[hits, overscan] = timed(helper, args.rounds)
+    print(f"[measure] {label}: beauty {beauty:.2f} s; helper 3 hits {results[3, 0]:.2f} s, "
+          f"3 hits + {args.overscan} px {results[3, args.overscan]:.2f} s, band only "
+          f"{results[1, args.overscan]:.2f} s (Blender {bpy.app.version_string})", flush=True)
+
+
+def main():
+    args = parse_args()
+    scene = bpy.context.scene
+    reference.clear_scene(scene)
+    reference.build_geometry(scene)
+    reference.setup_world(scene, 0.8)
+    reference.add_sun(scene)
+    reference.add_camera(scene, "persp")
+    render = scene.render
+    render.resolution_x, render.resolution_y = args.width, args.height
+    render.resolution_percentage = 100
+    render.engine = 'CYCLES'
+    scene.cycles.device = 'CPU'
+    scene.cycles.samples = args.samples
+    scene.cycles.use_denoising = False
+    scene.cycles.use_adaptive_sampling = False
+    render.use_persistent_data = args.persistent
+    size = f"{args.width}x{args.height}, {args.samples} spp" + \
+        (", persistent data" if args.persistent else "")
+    measure(scene, f"test scene ({size})", args)
+    triangles = heavy_mesh(scene, args.triangles)
+    measure(scene, f"test scene + {triangles / 1e6:.1f}M triangles ({size})", args)
+
+
+if __name__ == "__main__":
+    main()
