@@ -36,6 +36,12 @@ BLENDER_SCRIPTS = os.path.join(REPO_ROOT, "scripts", "blender")
 KIT_SCRIPTS = [os.path.join(BLENDER_SCRIPTS, name)
                for name in ("benchmark_scenes.py", "make_reference_scene.py")]
 SWEEP_SCRIPT = os.path.join(BLENDER_SCRIPTS, "cycles_ao_sweep.py")
+# The extra depth layers and guard band of a scene (and what their render depends on).
+LAYERS_SCRIPT = os.path.join(BLENDER_SCRIPTS, "benchmark_layers.py")
+LAYERS_SOURCES = KIT_SCRIPTS + [LAYERS_SCRIPT, os.path.join(BLENDER_SCRIPTS, "render_layers.py")] + [
+    os.path.join(REPO_ROOT, "blender_addon", name)
+    for name in ("hidden_surfaces.py", "multilayer.py", "compat.py")]
+GUARD_BAND = 64
 CSV_COLUMNS = ["scene", "method", "setting", "threads", "time_s", "rmse", "bias"]
 
 SD, HD = (640, 360), (1920, 1080)
@@ -71,6 +77,13 @@ LIBRARY_QUICK = [
     ("hemisphere", "default", []),
     ("horizon", "quality=medium", ["variant=horizon"]),
     ("sphere", "quality=medium", ["variant=sphere"]),
+]
+# The default with what an offline renderer can add (ssao_eval --layers): the 2nd and 3rd surface
+# hits with their facing, a guard band around the frame, both.
+LAYER_ROWS = [
+    ("hemisphere", "layers=2", ["layers=2"]),
+    ("hemisphere", "band=%d" % GUARD_BAND, ["band=%d" % GUARD_BAND]),
+    ("hemisphere", "layers=2,band=%d" % GUARD_BAND, ["layers=2", "band=%d" % GUARD_BAND]),
 ]
 # The straight ports of the seed tutorials (tests/reference/seed_ports.cpp) and the brute-force
 # ray march (the accuracy floor of any depth-buffer method; only at 640x360, it is slow).
@@ -147,9 +160,9 @@ def blender_command(blender, script, arguments):
 # ---------------------------------------------------------------------------------------------
 # 1. The kit
 
-def kit_key(blender_version, arguments):
+def kit_key(blender_version, arguments, sources=KIT_SCRIPTS):
     digest = hashlib.sha256()
-    for path in KIT_SCRIPTS:
+    for path in sources:
         with open(path, "rb") as f:
             digest.update(f.read())
     digest.update(blender_version.encode())
@@ -186,6 +199,30 @@ def kit_render(args, blender_version, scene, size, samples, seed=1, border=None)
     return prefix
 
 
+def kit_layers(args, blender_version, scene, size):
+    """The path of a scene's cached layers file (extra depth layers and a guard band), rendering
+    it first if it is not there."""
+    arguments = ["--scene", scene, "--width", str(size[0]), "--height", str(size[1]),
+                 "--overscan", str(GUARD_BAND)]
+    name = "%s-layers-%s" % (label(scene, size),
+                             kit_key(blender_version, arguments, LAYERS_SOURCES))
+    folder = os.path.join(args.kit, name)
+    path = os.path.join(folder, "ref.layers.exr")
+    if os.path.isfile(path):
+        return path
+    log("kit: rendering the depth layers and a %d px band of %s" % (GUARD_BAND, label(scene, size)))
+    partial = folder + ".partial"
+    shutil.rmtree(partial, ignore_errors=True)
+    os.makedirs(partial)
+    run_logged(blender_command(args.blender, LAYERS_SCRIPT,
+                               arguments + ["--threads", str(args.threads),
+                                            "--out", os.path.join(partial, "ref")]),
+               os.path.join(partial, "blender.log"), "the layers of " + label(scene, size))
+    shutil.rmtree(folder, ignore_errors=True)
+    os.replace(partial, folder)
+    return path
+
+
 # ---------------------------------------------------------------------------------------------
 # 2. Cycles' AO pass at fewer samples
 
@@ -214,13 +251,16 @@ def cycles_sweep(args, plan, scene, size, level):
 # ---------------------------------------------------------------------------------------------
 # 3. Scoring (and timing the library) with ssao_eval
 
-def run_eval(args, reference, runs, repeat, what):
-    """ssao_eval on the reference render with one --run per entry of `runs` (method and its
-    settings); returns one dict of the result line's fields per run, in order."""
+def run_eval(args, reference, runs, repeat, what, layers=None):
+    """ssao_eval on the reference render (with its layers file, if any) with one --run per entry
+    of `runs` (method and its settings); returns one dict of the result line's fields per run,
+    in order."""
     with open(reference + ".json", encoding="utf-8") as f:
         radius = json.load(f)["ao_distance"]
     command = [args.eval, reference + ".exr", "--camera", reference + ".camera.json",
                "--radius", repr(radius), "--repeat", str(repeat)]
+    if layers:
+        command += ["--layers", layers]
     for method, settings in runs:
         if any(c.isspace() for c in "".join(settings)):
             fail("ssao_eval takes no white space in a setting: %s (move the kit or the output "
@@ -236,10 +276,11 @@ def run_eval(args, reference, runs, repeat, what):
     return results
 
 
-def measure_scene(args, plan, reference, scene, size, sweeps):
-    """CSV rows for one scene and size: the library, the seed ports, the ray march, Cycles."""
+def measure_scene(args, plan, reference, scene, size, sweeps, layers=None):
+    """CSV rows for one scene and size: the library (with the layers file, if any), the seed
+    ports, the ray march, Cycles."""
     entries = []  # (the row's fields known before scoring, the ssao_eval run that scores it)
-    for method, setting, settings in plan.library:
+    for method, setting, settings in plan.library + (LAYER_ROWS if layers else []):
         entries.append(({"method": method, "setting": setting},
                         ("ssao", settings + ["threads=%d" % args.threads])))
     for method, setting, eval_method in plan.seed_rows:
@@ -257,7 +298,7 @@ def measure_scene(args, plan, reference, scene, size, sweeps):
     log("library: %s, %d configurations x %d run(s), and %d Cycles images"
         % (label(scene, size), timed, plan.repeat, len(entries) - timed))
     results = run_eval(args, reference, [run for _, run in entries], plan.repeat,
-                       label(scene, size))
+                       label(scene, size), layers)
     rows = []
     for (known, _), result in zip(entries, results):
         row = {"scene": label(scene, size), "time_s": float(result["time_ms"]) / 1000.0,
@@ -480,6 +521,27 @@ def rmse_by_size(rows):
     return by_size
 
 
+def layers_table(rows):
+    """Per scene: the default's RMSE alone, with the extra depth layers, with the guard band and
+    with both, and the time with layers over the default's; then the means."""
+    settings = ["default"] + [setting for _, setting, _ in LAYER_ROWS]
+    lines, means = [], {s: [] for s in settings}
+    for scene in dict.fromkeys(r["scene"] for r in rows):
+        found = {r["setting"]: r for r in rows
+                 if r["scene"] == scene and r["method"] == "hemisphere" and r["setting"] in settings}
+        if len(found) != len(settings):
+            continue
+        for s in settings:
+            means[s].append(found[s]["rmse"])
+        lines.append([scene] + ["%.4f" % found[s]["rmse"] for s in settings] +
+                     ["%.2fx" % (found[LAYER_ROWS[0][1]]["time_s"] / found["default"]["time_s"])])
+    if not lines:
+        return "(no scene has its layers file)"
+    lines.append(["**mean**"] + ["**%.4f**" % statistics.mean(means[s]) for s in settings] + [""])
+    return markdown_table(["scene", "one layer (default)", "+ 2nd, 3rd hits",
+                           "+ %d px band" % GUARD_BAND, "+ both", "time with layers"], lines)
+
+
 def write_markdown(path, images, args, plan, rows, table, complexity, noise, machine, command,
                    failed):
     """The report; `images` is the folder of the plots relative to it ("" or "images/")."""
@@ -512,6 +574,17 @@ def write_markdown(path, images, args, plan, rows, table, complexity, noise, mac
         speedup_table(table),
         "",
         "![run time against RMSE](%sspeed_error.png)" % images,
+        "",
+        "## Beyond one depth layer",
+        "",
+        "The default with what an offline renderer can add: the 2nd and 3rd surface hits along "
+        "each pixel's ray with their facing (`depth2`, `depth3`, `facing2`, `facing3`) and a "
+        "%d-pixel guard band around the frame (overscan), rendered by the add-on's helper render "
+        "(`scripts/blender/benchmark_layers.py`: Cycles, 1 sample per pixel) on the reference's "
+        "pixel grid. RMSE against the same reference as above; the time ratio is the AO "
+        "computation with 2 extra layers over the default's, the same run." % GUARD_BAND,
+        "",
+        layers_table(rows),
         "",
         "## Scene complexity",
         "",
@@ -662,15 +735,23 @@ def parse_args():
 
 
 def build_kit(args, plan, blender_version):
-    """The reference renders: {(scene, size): prefix}, {size: noise-check prefix}, failures."""
+    """The reference renders: {(scene, size): (prefix, layers file or None)}, {size: noise-check
+    prefix}, failures."""
     references, noise_parts, failed = {}, {}, []
     for scene, size in plan.scenes:
         try:
-            references[(scene, size)] = kit_render(args, blender_version, scene, size,
-                                                   plan.reference_samples[size])
+            prefix = kit_render(args, blender_version, scene, size, plan.reference_samples[size])
         except StepFailed as error:
             log("FAILED: %s" % error)
             failed.append(label(scene, size))
+            continue
+        try:
+            layers = kit_layers(args, blender_version, scene, size)
+        except StepFailed as error:
+            log("FAILED (the depth layers; the scene is measured without them): %s" % error)
+            failed.append(label(scene, size) + " layers")
+            layers = None
+        references[(scene, size)] = (prefix, layers)
     for size in plan.reference_samples:
         try:
             noise_parts[size] = kit_render(args, blender_version, plan.noise_scene, size,
@@ -685,11 +766,11 @@ def measure(args, plan, references):
     """Cycles sweeps and ssao_eval runs, scene by scene: (rows, complexity rows, failures). A
     scene that fails is reported and skipped; the others are still measured."""
     rows, complexity, failed = [], [], []
-    for (scene, size), reference in references.items():
+    for (scene, size), (reference, layers) in references.items():
         levels = plan.heavy_levels if scene == "heavy" else [0]
         try:
             sweeps = [(level, cycles_sweep(args, plan, scene, size, level)) for level in levels]
-            scene_rows = measure_scene(args, plan, reference, scene, size, sweeps)
+            scene_rows = measure_scene(args, plan, reference, scene, size, sweeps, layers)
         except StepFailed as error:
             log("FAILED: %s" % error)
             failed.append(label(scene, size))
@@ -729,7 +810,8 @@ def main():
     for size, part in sorted(noise_parts.items()):
         if (plan.noise_scene, size) in references:
             try:
-                sigma, pixels = reference_noise(args, references[(plan.noise_scene, size)], part)
+                sigma, pixels = reference_noise(args, references[(plan.noise_scene, size)][0],
+                                                part)
                 noise.append((sigma, "%dx%d" % size, pixels))
             except StepFailed as error:
                 log("FAILED (the noise check): %s" % error)
