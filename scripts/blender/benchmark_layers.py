@@ -55,13 +55,8 @@ def main():
     reference.ENGINES["cycles"](scene, args)
     reference.configure_render(scene, args, prefix + ".unused.exr")
     start = time.perf_counter()
-    # render_layers.py's file: the add-on's helper render, written by the add-on's EXR writer.
-    hidden_surfaces = render_layers.addon_module("hidden_surfaces")
-    multilayer = render_layers.addon_module("multilayer")
-    layers = hidden_surfaces.render_layers(scene, HITS, args.overscan,
-                                           folder=os.path.dirname(prefix))
-    multilayer.write(prefix + ".layers.exr", render_layers.channels("ViewLayer", layers, HITS),
-                     codec="ZIP", overscan=args.overscan)
+    render_layers.write_layers_file(scene, prefix + ".layers.exr", "ViewLayer", HITS,
+                                    args.overscan)
     seconds = time.perf_counter() - start
     with open(prefix + ".layers.json", "w", encoding="utf-8") as f:
         json.dump({"scene": args.scene, "width": args.width, "height": args.height,

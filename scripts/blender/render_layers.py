@@ -73,10 +73,21 @@ def channels(layer_name, layers, hits):
     return planes
 
 
-def main():
-    args = parse_args(export_cameras.script_argv())
+def write_layers_file(scene, output, layer_name, hits, overscan):
+    """Renders `scene`'s layers (the add-on's helper render) and writes them to `output` with
+    the channels of `layer_name`; returns the layers."""
     hidden_surfaces = addon_module("hidden_surfaces")
     multilayer = addon_module("multilayer")
+    layers = hidden_surfaces.render_layers(scene, hits, overscan,
+                                           folder=os.path.dirname(os.path.abspath(output)))
+    # Blender's own image save writes no data window and no channel names of ours: the add-on's
+    # EXR writer (checked against OpenImageIO) does both.
+    multilayer.write(output, channels(layer_name, layers, hits), codec="ZIP", overscan=overscan)
+    return layers
+
+
+def main():
+    args = parse_args(export_cameras.script_argv())
     scene = export_cameras.find_scene(args.scene)
     frame = scene.frame_current if args.frame is None else args.frame
     scene.frame_set(frame)
@@ -86,12 +97,7 @@ def main():
         _, description = export_cameras.frame_camera(scene, view_layer, None, frame, True)
     output = bpy.path.abspath(args.output)
     os.makedirs(os.path.dirname(os.path.abspath(output)), exist_ok=True)
-    layers = hidden_surfaces.render_layers(scene, args.hits, args.overscan,
-                                           folder=os.path.dirname(os.path.abspath(output)))
-    # Blender's own image save writes no data window and no channel names of ours: the add-on's
-    # EXR writer (checked against OpenImageIO) does both.
-    multilayer.write(output, channels(view_layer.name, layers, args.hits), codec="ZIP",
-                     overscan=args.overscan)
+    layers = write_layers_file(scene, output, view_layer.name, args.hits, args.overscan)
     if args.camera_json:
         export_cameras.write_json(bpy.path.abspath(args.camera_json), description)
     height, width = layers["depth"].shape
