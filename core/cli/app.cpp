@@ -88,14 +88,6 @@ ssao_io::Camera load_camera(const Options& options) {
   return camera;
 }
 
-std::vector<int> channel_indices(const ssao_io::Image& image, const std::vector<std::string>& names,
-                                 const std::string& path) {
-  std::vector<int> indices;
-  for (const std::string& name : names)
-    indices.push_back(ssao_io::require_channel(image, name, path));
-  return indices;
-}
-
 Inputs load_inputs(const Options& options) {
   Inputs in;
   in.image = ssao_io::read_image(options.input, ssao_io::Overscan::read);
@@ -116,24 +108,15 @@ Inputs load_inputs(const Options& options) {
                          "channels with --beauty-channels R,G,B[,A]");
   }
 
-  in.depth = ssao_io::extract_channels(in.image,
-                                       channel_indices(in.image, {in.passes.depth}, options.input));
-  if (!in.passes.normal.empty()) {
-    in.normal = ssao_io::extract_channels(
-        in.image, channel_indices(in.image, in.passes.normal, options.input));
-  }
-  if (!in.passes.beauty.empty()) {
-    in.beauty = ssao_io::extract_channels(
-        in.image, channel_indices(in.image, in.passes.beauty, options.input));
-  }
+  const auto pass = [&](const std::vector<std::string>& names) {
+    return ssao_io::extract_named_channels(in.image, names, options.input);
+  };
+  in.depth = pass({in.passes.depth});
+  if (!in.passes.normal.empty()) in.normal = pass(in.passes.normal);
+  if (!in.passes.beauty.empty()) in.beauty = pass(in.passes.beauty);
   for (const ssao_io::DepthLayerChannels& layer : in.passes.depth_layers) {
-    in.layer_depth.push_back(ssao_io::extract_channels(
-        in.image, channel_indices(in.image, {layer.depth}, options.input)));
-    in.layer_facing.push_back(
-        layer.facing.empty()
-            ? std::vector<float>()
-            : ssao_io::extract_channels(in.image,
-                                        channel_indices(in.image, {layer.facing}, options.input)));
+    in.layer_depth.push_back(pass({layer.depth}));
+    in.layer_facing.push_back(layer.facing.empty() ? std::vector<float>() : pass({layer.facing}));
   }
   in.image.pixels.clear();
   in.image.pixels.shrink_to_fit();

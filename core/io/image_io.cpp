@@ -129,6 +129,13 @@ int require_channel(const Image& image, const std::string& name, const std::stri
   return index;
 }
 
+std::vector<float> extract_named_channels(const Image& image, const std::vector<std::string>& names,
+                                          const std::string& path) {
+  std::vector<int> indices;
+  for (const std::string& name : names) indices.push_back(require_channel(image, name, path));
+  return extract_channels(image, indices);
+}
+
 std::vector<float> extract_channels(const Image& image, const std::vector<int>& indices) {
   const size_t n = indices.size();
   const size_t stride = static_cast<size_t>(image.channels());

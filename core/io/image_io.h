@@ -62,6 +62,9 @@ int require_channel(const Image& image, const std::string& name, const std::stri
 // Copies the channels `indices` (in that order) of every pixel into a tightly packed buffer
 // of width * height * indices.size() floats.
 std::vector<float> extract_channels(const Image& image, const std::vector<int>& indices);
+// The same for channels given by name (each required, as require_channel).
+std::vector<float> extract_named_channels(const Image& image, const std::vector<std::string>& names,
+                                          const std::string& path);
 
 // The frame's window (frame_*) of a pass extracted from `image` (`channels` floats a pixel,
 // tightly packed): its first pixel and byte strides, as ssao_job_set_image takes them.

@@ -339,16 +339,12 @@ void load_layers(const Options& o, Scene& s) {
   const ssao_io::PassChannels passes =
       ssao_io::detect_passes(image.channel_names, overrides, o.layers_file);
   const auto channel = [&](const std::string& name) {
-    return ssao_io::extract_channels(image, {ssao_io::require_channel(image, name, o.layers_file)});
+    return ssao_io::extract_named_channels(image, {name}, o.layers_file);
   };
   s.band = band;
   s.band_depth = channel(passes.depth);
   if (passes.normal.size() == 3) {
-    std::vector<int> indices;
-    for (const std::string& name : passes.normal) {
-      indices.push_back(ssao_io::require_channel(image, name, o.layers_file));
-    }
-    s.band_normal = ssao_io::extract_channels(image, indices);
+    s.band_normal = ssao_io::extract_named_channels(image, passes.normal, o.layers_file);
   }
   for (const ssao_io::DepthLayerChannels& layer : passes.depth_layers) {
     s.layer_depth.push_back(channel(layer.depth));
@@ -383,14 +379,9 @@ Scene load_scene(const Options& o) {
   }
   s.width = image.width;
   s.height = image.height;
-  s.depth =
-      ssao_io::extract_channels(image, {ssao_io::require_channel(image, passes.depth, o.scene)});
+  s.depth = ssao_io::extract_named_channels(image, {passes.depth}, o.scene);
   if (!passes.normal.empty()) {
-    std::vector<int> indices;
-    for (const std::string& name : passes.normal) {
-      indices.push_back(ssao_io::require_channel(image, name, o.scene));
-    }
-    s.world_normal = ssao_io::extract_channels(image, indices);
+    s.world_normal = ssao_io::extract_named_channels(image, passes.normal, o.scene);
   }
   s.truth = ssao_io::extract_channels(image, {ao_index});
 
