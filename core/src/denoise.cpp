@@ -14,6 +14,23 @@
 namespace ssao {
 namespace {
 
+// Where pixel centre (u, v) at planar depth d lies in view space, and the inverse of the plane
+// distance that halves a neighbour's weight there: a few pixel footprints, at most 10% of the
+// radius (max_scale), so a step of a fraction of the radius is an edge. Positions scale with
+// depth (per_depth = 1, perspective) or not (0, orthographic): as factors, so that the branch on
+// the camera type stays out of the callers' loops, which vectorise.
+struct PixelGeometry {
+  float x, y, z, inv_scale;
+};
+inline PixelGeometry pixel_geometry(const CameraIntrinsics& cam, float per_depth, float max_scale,
+                                    float u, float v, float d) {
+  const float depth_scale = d * per_depth + (1.0f - per_depth);
+  const float footprints = 4.0f * cam.scale_u * depth_scale;
+  return {(u - cam.center_u) * cam.scale_u * depth_scale,
+          (cam.center_v - v) * cam.scale_v * depth_scale, -d,
+          1.0f / ((footprints < max_scale ? footprints : max_scale) + 1e-30f)};
+}
+
 // One row of a GeometryBlock from the frame's planes: a loop without calls or branches, which
 // the compiler vectorises.
 SSAO_VECTORIZE void fill_geometry_row(const CameraIntrinsics cam, float max_scale, float v,
@@ -23,24 +40,16 @@ SSAO_VECTORIZE void fill_geometry_row(const CameraIntrinsics cam, float max_scal
                                       float* __restrict pz, float* __restrict nx,
                                       float* __restrict ny, float* __restrict nz,
                                       float* __restrict valid, float* __restrict inv_scale) {
-  // Positions scale with depth (perspective) or not (orthographic): as factors, so that the
-  // branch on the camera type stays out of the loop.
-  const float per_depth = cam.orthographic ? 0.0f : 1.0f, constant = 1.0f - per_depth;
+  const float per_depth = cam.orthographic ? 0.0f : 1.0f;
   for (int i = 0; i < count; ++i) {
     const float d = depth[i];
     const bool geometry = d != Frame::kBackground;
-    const float dd = geometry ? d : 1.0f;
-    const float depth_scale = dd * per_depth + constant;
-    px[i] = (float(x_begin + i) + 0.5f - cam.center_u) * cam.scale_u * depth_scale;
-    py[i] = (cam.center_v - v) * cam.scale_v * depth_scale;
-    pz[i] = -dd;
+    const PixelGeometry p = pixel_geometry(cam, per_depth, max_scale, float(x_begin + i) + 0.5f, v,
+                                           geometry ? d : 1.0f);
+    px[i] = p.x, py[i] = p.y, pz[i] = p.z, inv_scale[i] = p.inv_scale;
     const Vec3 n = decode_normal(normal[i]);
     nx[i] = n.x, ny[i] = n.y, nz[i] = n.z;
     valid[i] = geometry ? 1.0f : 0.0f;
-    // Plane distance that halves a neighbour's weight: a few pixel footprints, at most 10% of
-    // the radius, so a step of a fraction of the radius is an edge.
-    const float footprints = 4.0f * cam.scale_u * depth_scale;
-    inv_scale[i] = 1.0f / ((footprints < max_scale ? footprints : max_scale) + 1e-30f);
   }
 }
 
@@ -69,18 +78,24 @@ struct GeometryBlock {
 
 constexpr float kBilateralTaps[5] = {0.5f, 1.0f, 1.0f, 1.0f, 0.5f};
 
-// How much neighbour q may speak for centre p (the bilateral's and the upsampling's weight):
-// low when q lies off p's tangent plane (in units of p's plane scale) or when their normals
-// disagree; 0 when q is not geometry. Inline and branch-free, so the callers' loops vectorise.
+// How near point q lies to the plane through p with normal n: 1 on it, 1/2 at one plane scale
+// (1 / inv_scale) off it. Inline and branch-free, so the callers' loops vectorise.
+inline float plane_weight(float px, float py, float pz, float nx, float ny, float nz,
+                          float inv_scale, float qx, float qy, float qz) {
+  const float plane = ((qx - px) * nx + (qy - py) * ny + (qz - pz) * nz) * inv_scale;
+  return 1.0f / (1.0f + plane * plane);
+}
+
+// How much neighbour q may speak for centre p (the bilateral's weight): low when q lies off
+// p's tangent plane (in units of p's plane scale) or when their normals disagree; 0 when q is
+// not geometry.
 inline float surface_weight(float px, float py, float pz, float nx, float ny, float nz,
                             float inv_scale, float qx, float qy, float qz, float qnx, float qny,
                             float qnz, float q_valid) {
-  const float plane = (qx - px) * nx + (qy - py) * ny + (qz - pz) * nz;
-  const float plane_distance = (plane < 0.0f ? -plane : plane) * inv_scale;
   const float cosine = qnx * nx + qny * ny + qnz * nz;
   const float agreement = cosine > 0.0f ? cosine : 0.0f;
   const float a2 = agreement * agreement;
-  return q_valid * a2 * a2 / (1.0f + plane_distance * plane_distance);
+  return q_valid * a2 * a2 * plane_weight(px, py, pz, nx, ny, nz, inv_scale, qx, qy, qz);
 }
 
 // Filters `count` pixels starting at block index `centre`; the taps are `stride` apart in the
@@ -152,37 +167,57 @@ RowPlanes row_planes(const GeometryBlock& g, int x, int y, const float* values) 
   return {&g.px[i], &g.py[i], &g.pz[i], &g.nx[i], &g.ny[i], &g.nz[i], &g.valid[i], values};
 }
 
-// The full-resolution pixels x = 2 k + parity (k = 0 .. count - 1) of one row, from the two
-// half-resolution rows around it. Half-resolution column c has its centre at full-resolution
-// 2 c + 1, so pixel 2 k + parity lies between half columns k - 1 + parity and k + parity,
-// weighted 3/4 : 1/4 toward the nearer; `low` and `high` are indexed so that [k] is column k
-// (and [-1] exists). Contiguous loads only: the loop vectorises.
-SSAO_VECTORIZE void upsample_run(const RowPlanes centre, const float* __restrict inv_scale,
+// The full-resolution pixels x = 2 k + parity (k = 0 .. count - 1) of one row (depths
+// depth[2 k], pixel centres u_first + 2 k, v), from the two half-resolution rows around it.
+// Half-resolution column c has its centre at full-resolution 2 c + 1, so pixel 2 k + parity
+// lies between half columns k - 1 + parity and k + parity, weighted 3/4 : 1/4 toward the nearer;
+// `low` and `high` are indexed so that [k] is column k (and [-1] exists). A neighbour's weight
+// also falls with the pixel's distance from the neighbour's tangent plane: the neighbour's
+// plane, so the pixel needs only its depth (a full frame estimated at half resolution keeps no
+// normals). Contiguous and stride-2 loads only: the loop vectorises.
+SSAO_VECTORIZE void upsample_run(const CameraIntrinsics cam, float max_scale,
+                                 const float* __restrict depth, float u_first, float v,
                                  const RowPlanes low, const RowPlanes high, float high_weight,
                                  int parity, int count, float* __restrict out) {
+  const float per_depth = cam.orthographic ? 0.0f : 1.0f;
   const float low_weight = 1.0f - high_weight;
   const float right_weight = parity ? 0.25f : 0.75f;
+  const RowPlanes rows[2] = {low, high};
+  const float row_weights[2] = {low_weight, high_weight};
+  // No neighbour on this surface (a one-pixel feature): the pixel's own block, k.
+  const float* __restrict own = high_weight > 0.5f ? high.value : low.value;
   for (int k = 0; k < count; ++k) {
-    const int i = 2 * k;  // the pixel in the centre row's planes (which start at this parity)
+    const float d = depth[2 * k];
+    const bool geometry = d != Frame::kBackground;
+    const PixelGeometry p = pixel_geometry(cam, per_depth, max_scale, u_first + 2.0f * float(k), v,
+                                           geometry ? d : 1.0f);
     const int left = k - 1 + parity, right = k + parity;
     float sum = 0.0f, weight_sum = 0.0f;
-    // One half-resolution neighbour: bilinear weight, tangent-plane distance, normal agreement.
-    auto tap = [&](const RowPlanes& r, int c, float bilinear) {
-      const float w = (bilinear + 1e-3f) * surface_weight(centre.px[i], centre.py[i], centre.pz[i],
-                                                          centre.nx[i], centre.ny[i], centre.nz[i],
-                                                          inv_scale[i], r.px[c], r.py[c], r.pz[c],
-                                                          r.nx[c], r.ny[c], r.nz[c], r.valid[c]);
-      sum += w * r.value[c];
-      weight_sum += w;
-    };
-    tap(low, left, low_weight * (1.0f - right_weight));
-    tap(low, right, low_weight * right_weight);
-    tap(high, left, high_weight * (1.0f - right_weight));
-    tap(high, right, high_weight * right_weight);
-    // No neighbour on this surface (a one-pixel feature): the pixel's own block, k.
-    const float own = high_weight > 0.5f ? high.value[k] : low.value[k];
-    const float upsampled = weight_sum > 1e-6f ? sum / weight_sum : own;
-    out[k] = centre.valid[i] > 0.0f ? upsampled : 1.0f;
+    // Local restrict pointers: without them the compiler must assume `out` aliases the planes
+    // read, and leaves the loop scalar.
+#pragma GCC unroll 2
+    for (int r = 0; r < 2; ++r) {
+      const float* __restrict qx = rows[r].px;
+      const float* __restrict qy = rows[r].py;
+      const float* __restrict qz = rows[r].pz;
+      const float* __restrict qnx = rows[r].nx;
+      const float* __restrict qny = rows[r].ny;
+      const float* __restrict qnz = rows[r].nz;
+      const float* __restrict qvalid = rows[r].valid;
+      const float* __restrict qvalue = rows[r].value;
+#pragma GCC unroll 2
+      for (int side = 0; side < 2; ++side) {
+        const int c = side ? right : left;
+        const float bilinear = row_weights[r] * (side ? right_weight : 1.0f - right_weight);
+        const float w =
+            (bilinear + 1e-3f) * qvalid[c] *
+            plane_weight(qx[c], qy[c], qz[c], qnx[c], qny[c], qnz[c], p.inv_scale, p.x, p.y, p.z);
+        sum += w * qvalue[c];
+        weight_sum += w;
+      }
+    }
+    const float upsampled = weight_sum > 1e-6f ? sum / weight_sum : own[k];
+    out[k] = geometry ? upsampled : 1.0f;
   }
 }
 
@@ -230,9 +265,8 @@ void Denoiser::vertical_pass(const float* visibility, const Tile& t, float* out)
 void upsample(const Frame& full, const Frame& half, const float* half_visibility, float radius,
               const Tile& t, float* out) {
   const int width = t.x1 - t.x0;
-  // Full-resolution planes of the tile, and half-resolution planes of the columns around it
-  // with one column of apron either side (outside the image: not geometry, weight 0).
-  const GeometryBlock centre(full, radius, t.x0, t.y0, t.x1, t.y1);
+  // Half-resolution planes of the columns around the tile with one column of apron either side
+  // (outside the image: not geometry, weight 0).
   const int half_x0 = (t.x0 >> 1) - 1, half_x1 = ((t.x1 - 1) >> 1) + 2;
   const int low_row0 = std::max(0, (t.y0 - 1) >> 1);
   const int high_row1 = std::min(half.height(), ((t.y1 - 1) >> 1) + 2);
@@ -254,9 +288,9 @@ void upsample(const Frame& full, const Frame& half, const float* half_visibility
       const int count = x_first < t.x1 ? (t.x1 - x_first + 1) / 2 : 0;
       if (count == 0) continue;
       const int k0 = x_first >> 1;
-      upsample_run(row_planes(centre, x_first, y, nullptr),
-                   &centre.inv_scale[centre.at(x_first, y)],
-                   row_planes(around, k0, low, &values[around.at(k0, low)]),
+      upsample_run(full.camera().intrinsics(), 0.1f * radius,
+                   full.depth_plane() + full.index(x_first, y), float(x_first) + 0.5f,
+                   float(y) + 0.5f, row_planes(around, k0, low, &values[around.at(k0, low)]),
                    row_planes(around, k0, high, &values[around.at(k0, high)]),
                    (y & 1) ? 0.25f : 0.75f, parity, count, by_parity[parity].data());
       float* row = out + size_t(y - t.y0) * width;

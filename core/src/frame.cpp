@@ -20,7 +20,8 @@ void Frame::reset(const CameraModel& camera, int width, int height, int extra_la
   height_ = height;
   extra_layers_ = extra_layers;
   depth_.resize(size_t(width) * size_t(height));
-  normal_.resize(size_t(width) * size_t(height));
+  // The normal plane is sized by build_normals or downsample (a full frame estimated at half
+  // resolution has none).
   layers_.resize(size_t(extra_layers) * size_t(width) * size_t(height));
 }
 
@@ -53,7 +54,24 @@ bool Frame::has_geometry(int x0, int y0, int x1, int y1) const {
   return false;
 }
 
+namespace {
+// View-space normals from world-space ones: the transpose of the camera's rotation (the
+// inverse-transpose of world-to-camera, so a scaled camera matrix works too; renormalised).
+void normal_rotation(const FrameInputs& in, float rotation[9]) {
+  const double* m = in.camera_to_world;
+  const float to_view[9] = {float(m[0]), float(m[4]), float(m[8]), float(m[1]), float(m[5]),
+                            float(m[9]), float(m[2]), float(m[6]), float(m[10])};
+  const float identity[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
+  std::copy_n(in.world_normals ? to_view : identity, 9, rotation);
+}
+}  // namespace
+
 void Frame::build(const FrameInputs& in, TilePool& pool, Progress& progress) {
+  build_depth(in, pool, progress);
+  build_normals(in, pool, progress);
+}
+
+void Frame::build_depth(const FrameInputs& in, TilePool& pool, Progress& progress) {
   // A depth at or beyond this is background (so are NaN, infinity and depths <= 0).
   const float limit =
       in.clip_end > 0.0f ? std::min(in.background_depth, in.clip_end) : in.background_depth;
@@ -65,15 +83,13 @@ void Frame::build(const FrameInputs& in, TilePool& pool, Progress& progress) {
       for (int k = 0; k < extra_layers_; ++k) layer_row(in, k, t.x0, t.x1 - t.x0, y, limit);
     }
   });
+}
 
-  // Normals need the neighbours' depths, so they come after every depth is known.
-  // View-space normals from world-space ones: the transpose of the camera's rotation (the
-  // inverse-transpose of world-to-camera, so a scaled camera matrix works too; renormalised).
-  const double* m = in.camera_to_world;
-  const float to_view[9] = {float(m[0]), float(m[4]), float(m[8]), float(m[1]), float(m[5]),
-                            float(m[9]), float(m[2]), float(m[6]), float(m[10])};
-  const float identity[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
-  const float* rotation = in.world_normals ? to_view : identity;
+// Normals need the neighbours' depths, so they come after every depth is known.
+void Frame::build_normals(const FrameInputs& in, TilePool& pool, Progress& progress) {
+  normal_.resize(pixel_count());
+  float rotation[9];
+  normal_rotation(in, rotation);
   const uint32_t facing = encode_normal({0.0f, 0.0f, 1.0f});
   pool.for_each_tile(width_, height_, progress, [&](const Tile& t) {
     const int count = t.x1 - t.x0;
@@ -168,10 +184,19 @@ void Frame::layer_row(const FrameInputs& in, int k, int x0, int count, int y, fl
   }
 }
 
-void Frame::downsample(const Frame& full, TilePool& pool, Progress& progress) {
+void Frame::downsample(const Frame& full, const FrameInputs& in, TilePool& pool,
+                       Progress& progress) {
   reset(full.camera().coarser(2), (full.width() + 1) / 2, (full.height() + 1) / 2,
         full.extra_layers());
+  normal_.resize(pixel_count());
+  float rotation[9];
+  normal_rotation(in, rotation);
+  const uint32_t facing = encode_normal({0.0f, 0.0f, 1.0f});
   pool.for_each_tile(width_, height_, progress, [&](const Tile& t) {
+    const int count = t.x1 - t.x0;
+    std::vector<float> nx(count, 0.0f), ny(count, 0.0f), nz(count, 0.0f);
+    std::vector<uint32_t> usable(count);
+    std::vector<size_t> chosen(count);
     for (int y = t.y0; y < t.y1; ++y) {
       for (int x = t.x0; x < t.x1; ++x) {
         // The nearest pixel of the block: thin foreground survives, and a block on a
@@ -187,11 +212,33 @@ void Frame::downsample(const Frame& full, TilePool& pool, Progress& progress) {
           }
         }
         depth_[index(x, y)] = nearest;
-        normal_[index(x, y)] = full.normal_[best];
+        chosen[x - t.x0] = best;
         for (int k = 0; k < extra_layers_; ++k) {
           layers_[size_t(k) * pixel_count() + index(x, y)] =
               nearest == kBackground ? kBackground
                                      : full.layers_[size_t(k) * full.pixel_count() + best];
+        }
+      }
+      // Only the chosen pixels' normals are read and packed: a quarter of the full frame's.
+      // They are turned towards the camera along this frame's pixel rays, the rays on which
+      // the variants place them.
+      const size_t row = index(t.x0, y);
+      if (in.normal.attached()) {
+        for (int i = 0; i < count; ++i) {
+          const int fx = int(chosen[i] % size_t(full.width()));
+          const int fy = int(chosen[i] / size_t(full.width()));
+          const float* p = in.normal.pixel(fx, fy);
+          nx[i] = p[0], ny[i] = p[1], nz[i] = p[2];
+        }
+      }
+      encode_normal_row(rotation, float(y) + 0.5f, t.x0, count, nx.data(), ny.data(), nz.data(),
+                        usable.data(), normal_.data() + row);
+      for (int i = 0; i < count; ++i) {
+        if (depth_[row + i] == kBackground) {
+          normal_[row + i] = facing;
+        } else if (!usable[i]) {
+          normal_[row + i] = encode_normal(full.reconstructed_normal(
+              int(chosen[i] % size_t(full.width())), int(chosen[i] / size_t(full.width()))));
         }
       }
     }

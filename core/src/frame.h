@@ -76,11 +76,14 @@ class Frame {
 
   // Fills the depth plane, then the normals (from the normal image or reconstructed from depth).
   void build(const FrameInputs& in, TilePool& pool, Progress& progress);
+  // The depth plane (and extra layers) alone: what a frame estimated at half resolution needs
+  // of the full one. Its normal plane is not filled.
+  void build_depth(const FrameInputs& in, TilePool& pool, Progress& progress);
 
   // This frame at half resolution: each 2x2 block becomes one pixel with the depth and normal
   // of its nearest geometry pixel (background if it has none), seen through full.camera()
-  // made twice as coarse.
-  void downsample(const Frame& full, TilePool& pool, Progress& progress);
+  // made twice as coarse. `full` needs its depth only; the normals are read from `in`.
+  void downsample(const Frame& full, const FrameInputs& in, TilePool& pool, Progress& progress);
 
   int width() const { return width_; }
   int height() const { return height_; }
@@ -116,6 +119,7 @@ class Frame {
 
  private:
   Vec3 reconstructed_normal(int x, int y) const;
+  void build_normals(const FrameInputs& in, TilePool& pool, Progress& progress);
   void depth_row(float* depth, int x0, int count, float v, bool radial, float limit) const;
   void encode_normal_row(const float* rotation, float v, int x0, int count, const float* nx,
                          const float* ny, const float* nz, uint32_t* usable, uint32_t* out) const;

@@ -346,17 +346,20 @@ void Job::run() {
       std::min(v.get_float("clip_end"), double(std::numeric_limits<float>::max())));
 
   progress.set_stage(0.0, 0.05);
-  Frame& frame = frame_;
-  frame.reset(camera, width, height, in.extra_layers);
-  frame.build(in, tiles, progress);
-
   // The frame the variant sees: the input's, or a half-resolution copy (a quarter of the work;
-  // the result is upsampled at the output).
+  // the result is upsampled at the output, which needs the full frame's depths only).
   const std::string& resolution = v.get_string("resolution");
   const bool half_resolution =
       resolution == "half" ||
       (resolution == "auto" && double(width) * double(height) >= kHalfResolutionPixels);
-  if (half_resolution) half_frame_.downsample(frame, tiles, progress);
+  Frame& frame = frame_;
+  frame.reset(camera, width, height, in.extra_layers);
+  if (half_resolution) {
+    frame.build_depth(in, tiles, progress);
+    half_frame_.downsample(frame, in, tiles, progress);
+  } else {
+    frame.build(in, tiles, progress);
+  }
   const Frame& seen = half_resolution ? half_frame_ : frame;
   // At most three image-size buffers: the full frame's two planes and one of visibility (or the
   // half frame's planes and visibility, a quarter each). What the other mode kept is freed.
