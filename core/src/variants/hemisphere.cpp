@@ -84,14 +84,17 @@ void hemisphere_row(const HemisphereRowArgs& a, int y, int x0, int x1, float* ou
   alignas(64) float result[kMaxLanes];
   for (int x = x0; x < x1; x += lanes) {
     const int count = std::min(lanes, x1 - x);
-    // Stage the lanes, padding past the row's end with background.
-    for (int i = 0; i < lanes; ++i) {
-      const bool inside = i < count;
-      depth_in[i] =
-          inside ? a.depth[size_t(y) * a.width + x + i] : std::numeric_limits<float>::infinity();
-      normal_in[i] = inside ? int32_t(a.normals[size_t(y) * a.width + x + i]) : 0;
+    const float* depth_at = a.depth + size_t(y) * a.width + x;
+    const uint32_t* normal_at = a.normals + size_t(y) * a.width + x;
+    if (count < lanes) {  // stage the lanes, padding past the row's end with background
+      for (int i = 0; i < lanes; ++i) {
+        depth_in[i] = i < count ? depth_at[i] : std::numeric_limits<float>::infinity();
+        normal_in[i] = i < count ? int32_t(normal_at[i]) : 0;
+      }
+      depth_at = depth_in;
+      normal_at = reinterpret_cast<const uint32_t*>(normal_in);
     }
-    const VF depth = hn::Load(df, depth_in);
+    const VF depth = hn::LoadU(df, depth_at);
     const VF footprint = cam.orthographic ? scale_u : scale_u * depth;
     const auto receiver = hn::And(hn::Lt(depth, inf), hn::Ge(radius, half * footprint));
     if (hn::AllFalse(df, receiver)) {
@@ -108,7 +111,7 @@ void hemisphere_row(const HemisphereRowArgs& a, int y, int x0, int x1, float* ou
     const VF pz = hn::Neg(safe_depth);
 
     VF nx, ny, nz;
-    decode_normals(df, hn::Load(di, normal_in), nx, ny, nz);
+    decode_normals(df, hn::LoadU(di, reinterpret_cast<const int32_t*>(normal_at)), nx, ny, nz);
 
     // Tangent frame (orthonormal_basis in vec3.h).
     const VF sign = hn::CopySign(one, nz);
@@ -125,7 +128,11 @@ void hemisphere_row(const HemisphereRowArgs& a, int y, int x0, int x1, float* ou
     for (int k = 0; k < a.directions; ++k) {
       VF blocked = zero;
       auto seen = hn::Lt(one, zero);  // all false
+      const float* const direction_end = offset + size_t(a.steps) * 3 * kLaneTable;
       for (int step = 0; step < a.steps; ++step, offset += 3 * kLaneTable) {
+        // A direction fully blocked on every lane stays so (it counts its strongest occluder,
+        // and a weight is at most 1): its remaining steps cannot change the result.
+        if (step > 0 && hn::AllTrue(df, hn::Or(hn::Ge(blocked, one), hn::Not(receiver)))) break;
         const VF ox = hn::LoadU(df, offset), oy = hn::LoadU(df, offset + kLaneTable),
                  oz = hn::LoadU(df, offset + 2 * kLaneTable);
         const VF sx = hn::MulAdd(tx, ox, hn::MulAdd(bx, oy, hn::MulAdd(nx, oz, px)));
@@ -205,6 +212,7 @@ void hemisphere_row(const HemisphereRowArgs& a, int y, int x0, int x1, float* ou
         const VF weight = hn::Min(one, hn::Max(zero, two - behind * inv_thickness));
         blocked = hn::Max(blocked, hn::IfThenElseZero(counts, weight));
       }
+      offset = direction_end;
       valid = valid + hn::IfThenElseZero(seen, one);
       occlusion = occlusion + hn::IfThenElseZero(seen, blocked);
     }
