@@ -168,13 +168,14 @@ RowPlanes row_planes(const GeometryBlock& g, int x, int y, const float* values) 
 }
 
 // The full-resolution pixels x = 2 k + parity (k = 0 .. count - 1) of one row (depths
-// depth[2 k], pixel centres u_first + 2 k, v), from the two half-resolution rows around it.
+// depth[k], pixel centres u_first + 2 k, v), from the two half-resolution rows around it.
 // Half-resolution column c has its centre at full-resolution 2 c + 1, so pixel 2 k + parity
 // lies between half columns k - 1 + parity and k + parity, weighted 3/4 : 1/4 toward the nearer;
 // `low` and `high` are indexed so that [k] is column k (and [-1] exists). A neighbour's weight
 // also falls with the pixel's distance from the neighbour's tangent plane: the neighbour's
 // plane, so the pixel needs only its depth (a full frame estimated at half resolution keeps no
-// normals). Contiguous and stride-2 loads only: the loop vectorises.
+// normals). Contiguous loads only (a stride-2 load would leave the last vector to a scalar
+// epilogue): the loop vectorises.
 SSAO_VECTORIZE void upsample_run(const CameraIntrinsics cam, float max_scale,
                                  const float* __restrict depth, float u_first, float v,
                                  const RowPlanes low, const RowPlanes high, float high_weight,
@@ -187,7 +188,7 @@ SSAO_VECTORIZE void upsample_run(const CameraIntrinsics cam, float max_scale,
   // No neighbour on this surface (a one-pixel feature): the pixel's own block, k.
   const float* __restrict own = high_weight > 0.5f ? high.value : low.value;
   for (int k = 0; k < count; ++k) {
-    const float d = depth[2 * k];
+    const float d = depth[k];
     const bool geometry = d != Frame::kBackground;
     const PixelGeometry p = pixel_geometry(cam, per_depth, max_scale, u_first + 2.0f * float(k), v,
                                            geometry ? d : 1.0f);
@@ -262,8 +263,8 @@ void Denoiser::vertical_pass(const float* visibility, const Tile& t, float* out)
   }
 }
 
-void upsample(const Frame& full, const Frame& half, const float* half_visibility, float radius,
-              const Tile& t, float* out) {
+void upsample(const Frame& full, const Frame& half, const float* half_visibility,
+              const Denoiser& vertical, float radius, const Tile& t, float* out) {
   const int width = t.x1 - t.x0;
   // Half-resolution planes of the columns around the tile with one column of apron either side
   // (outside the image: not geometry, weight 0).
@@ -271,14 +272,21 @@ void upsample(const Frame& full, const Frame& half, const float* half_visibility
   const int low_row0 = std::max(0, (t.y0 - 1) >> 1);
   const int high_row1 = std::min(half.height(), ((t.y1 - 1) >> 1) + 2);
   const GeometryBlock around(half, radius, half_x0, low_row0, half_x1, high_row1);
+  // The vertical pass of the half-resolution visibility, over what this tile reads: one pass
+  // over the image less, for the few rows two tiles both read.
+  const Tile read{std::max(half_x0, 0), low_row0, std::min(half_x1, half.width()), high_row1};
+  const int read_width = read.x1 - read.x0;
+  std::vector<float> filtered(size_t(read_width) * size_t(read.y1 - read.y0));
+  vertical.vertical_pass(half_visibility, read, filtered.data());
   std::vector<float> values(size_t(half_x1 - half_x0) * size_t(high_row1 - low_row0), 1.0f);
-  for (int y = low_row0; y < high_row1; ++y) {
-    for (int x = std::max(half_x0, 0); x < std::min(half_x1, half.width()); ++x) {
-      values[around.at(x, y)] = half_visibility[half.index(x, y)];
-    }
+  for (int y = read.y0; y < read.y1; ++y) {
+    std::copy_n(filtered.data() + size_t(y - read.y0) * read_width, read_width,
+                values.data() + around.at(read.x0, y));
   }
-  std::vector<float> by_parity[2] = {std::vector<float>(size_t(width) / 2 + 1),
-                                     std::vector<float>(size_t(width) / 2 + 1)};
+  const size_t per_parity = size_t(width) / 2 + 1;
+  std::vector<float> by_parity[2] = {std::vector<float>(per_parity),
+                                     std::vector<float>(per_parity)};
+  std::vector<float> depth_of_parity(per_parity);
   for (int y = t.y0; y < t.y1; ++y) {
     const int low_raw = (y - 1) >> 1;
     const int low = std::max(low_raw, 0), high = std::min(low_raw + 1, half.height() - 1);
@@ -288,28 +296,17 @@ void upsample(const Frame& full, const Frame& half, const float* half_visibility
       const int count = x_first < t.x1 ? (t.x1 - x_first + 1) / 2 : 0;
       if (count == 0) continue;
       const int k0 = x_first >> 1;
-      upsample_run(full.camera().intrinsics(), 0.1f * radius,
-                   full.depth_plane() + full.index(x_first, y), float(x_first) + 0.5f,
-                   float(y) + 0.5f, row_planes(around, k0, low, &values[around.at(k0, low)]),
+      const float* depth = full.depth_plane() + full.index(x_first, y);
+      for (int k = 0; k < count; ++k) depth_of_parity[size_t(k)] = depth[2 * k];
+      upsample_run(full.camera().intrinsics(), 0.1f * radius, depth_of_parity.data(),
+                   float(x_first) + 0.5f, float(y) + 0.5f,
+                   row_planes(around, k0, low, &values[around.at(k0, low)]),
                    row_planes(around, k0, high, &values[around.at(k0, high)]),
                    (y & 1) ? 0.25f : 0.75f, parity, count, by_parity[parity].data());
       float* row = out + size_t(y - t.y0) * width;
       for (int k = 0; k < count; ++k) row[x_first + 2 * k - t.x0] = by_parity[parity][k];
     }
   }
-}
-
-void Denoiser::vertical_pass_in_place(float* visibility, TilePool& pool, Progress& progress) const {
-  if (mode_ == DenoiseMode::none) return;
-  pool.for_each_column_band(f_.width(), f_.height(), 32, progress, [&](const Tile& t) {
-    // A band reads and writes only its own columns: filter into a copy, then write it back.
-    const int width = t.x1 - t.x0;
-    std::vector<float> filtered(size_t(width) * size_t(f_.height()));
-    vertical_pass(visibility, t, filtered.data());
-    for (int y = 0; y < f_.height(); ++y) {
-      std::copy_n(filtered.data() + size_t(y) * width, width, visibility + f_.index(t.x0, y));
-    }
-  });
 }
 
 }  // namespace ssao

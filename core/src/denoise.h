@@ -26,8 +26,6 @@ class Denoiser {
   // The vertical pass over one tile, reading the horizontally filtered visibility; writes
   // out[(y - t.y0) * (t.x1 - t.x0) + (x - t.x0)].
   void vertical_pass(const float* visibility, const Tile& t, float* out) const;
-  // The vertical pass over the whole image, in place (bands of columns).
-  void vertical_pass_in_place(float* visibility, TilePool& pool, Progress& progress) const;
 
  private:
   const Frame& f_;
@@ -36,12 +34,12 @@ class Denoiser {
 };
 
 // Joint bilateral upsampling of a half-resolution estimate (resolution = half): the visibility
-// of the full-resolution pixels of tile t into out (tile-local rows), from the visibility of
-// `half` (made by Frame::downsample of `full`). Each pixel takes the four half-resolution
-// pixels around it, weighted bilinearly and, as the bilateral filter weighs, by their distance
-// from the pixel's tangent plane and their normals' agreement, so AO does not leak across
-// silhouettes. Background pixels get 1.
-void upsample(const Frame& full, const Frame& half, const float* half_visibility, float radius,
-              const Tile& t, float* out);
+// of the full-resolution pixels of tile t into out (tile-local rows), from the horizontally
+// filtered visibility of `half` (made by Frame::downsample of `full`), whose vertical pass
+// `vertical` runs here on the rows the tile reads. Each pixel takes the four half-resolution
+// pixels around it, weighted bilinearly and by its distance from their tangent planes, so AO
+// does not leak across silhouettes. Background pixels get 1.
+void upsample(const Frame& full, const Frame& half, const float* half_visibility,
+              const Denoiser& vertical, float radius, const Tile& t, float* out);
 
 }  // namespace ssao

@@ -184,6 +184,25 @@ void Frame::layer_row(const FrameInputs& in, int k, int x0, int count, int y, fl
   }
 }
 
+// The nearest of each 2x2 block of two full-resolution rows: `count` blocks of columns 2 i and
+// 2 i + 1; its depth, and which corner it is (0, 1 on the top row, 2, 3 on the bottom; the first
+// on ties). Selects only, so the loop vectorises.
+SSAO_VECTORIZE void Frame::nearest_of_blocks(const float* __restrict top,
+                                             const float* __restrict bottom, int count,
+                                             float* __restrict depth, int32_t* __restrict corner) {
+  for (int i = 0; i < count; ++i) {
+    float nearest = top[2 * i];
+    int32_t which = 0;
+    const float candidates[3] = {top[2 * i + 1], bottom[2 * i], bottom[2 * i + 1]};
+    for (int c = 0; c < 3; ++c) {
+      which = candidates[c] < nearest ? c + 1 : which;
+      nearest = candidates[c] < nearest ? candidates[c] : nearest;
+    }
+    depth[i] = nearest;
+    corner[i] = which;
+  }
+}
+
 void Frame::downsample(const Frame& full, const FrameInputs& in, TilePool& pool,
                        Progress& progress) {
   reset(full.camera().coarser(2), (full.width() + 1) / 2, (full.height() + 1) / 2,
@@ -196,27 +215,32 @@ void Frame::downsample(const Frame& full, const FrameInputs& in, TilePool& pool,
     const int count = t.x1 - t.x0;
     std::vector<float> nx(count, 0.0f), ny(count, 0.0f), nz(count, 0.0f);
     std::vector<uint32_t> usable(count);
-    std::vector<size_t> chosen(count);
+    std::vector<int32_t> corner(count), chosen_x(count), chosen_y(count);
     for (int y = t.y0; y < t.y1; ++y) {
-      for (int x = t.x0; x < t.x1; ++x) {
-        // The nearest pixel of the block: thin foreground survives, and a block on a
-        // silhouette takes one surface's depth and normal, never a blend of two.
-        size_t best = 0;
-        float nearest = kBackground;
-        for (int dy = 0; dy < 2; ++dy) {
-          for (int dx = 0; dx < 2; ++dx) {
-            const int fx = 2 * x + dx, fy = 2 * y + dy;
-            if (fx >= full.width() || fy >= full.height()) continue;
-            const size_t i = full.index(fx, fy);
-            if (full.depth_[i] < nearest) nearest = full.depth_[i], best = i;
-          }
-        }
-        depth_[index(x, y)] = nearest;
-        chosen[x - t.x0] = best;
-        for (int k = 0; k < extra_layers_; ++k) {
-          layers_[size_t(k) * pixel_count() + index(x, y)] =
-              nearest == kBackground ? kBackground
-                                     : full.layers_[size_t(k) * full.pixel_count() + best];
+      // The nearest pixel of each block: thin foreground survives, and a block on a silhouette
+      // takes one surface's depth and normal, never a blend of two. A last row or column past
+      // the full frame's edge repeats the one before it (it cannot win: ties keep the first).
+      const int top = 2 * y, bottom = std::min(2 * y + 1, full.height() - 1);
+      const int pairs = std::min(t.x1, full.width() / 2) - t.x0;  // blocks with two columns
+      float* depth = depth_.data() + index(t.x0, y);
+      nearest_of_blocks(full.depth_.data() + full.index(2 * t.x0, top),
+                        full.depth_.data() + full.index(2 * t.x0, bottom), pairs, depth,
+                        corner.data());
+      for (int i = std::max(pairs, 0); i < count; ++i) {  // the odd last column
+        const float a = full.depth(2 * (t.x0 + i), top), b = full.depth(2 * (t.x0 + i), bottom);
+        depth[i] = b < a ? b : a;
+        corner[i] = b < a ? 2 : 0;
+      }
+      for (int i = 0; i < count; ++i) {
+        chosen_x[i] = 2 * (t.x0 + i) + (corner[i] & 1);
+        chosen_y[i] = corner[i] >= 2 ? bottom : top;
+      }
+      for (int k = 0; k < extra_layers_; ++k) {
+        const float* hits = full.layers_.data() + size_t(k) * full.pixel_count();
+        float* row = layers_.data() + size_t(k) * pixel_count() + index(t.x0, y);
+        for (int i = 0; i < count; ++i) {
+          row[i] =
+              depth[i] == kBackground ? kBackground : hits[full.index(chosen_x[i], chosen_y[i])];
         }
       }
       // Only the chosen pixels' normals are read and packed: a quarter of the full frame's.
@@ -225,9 +249,7 @@ void Frame::downsample(const Frame& full, const FrameInputs& in, TilePool& pool,
       const size_t row = index(t.x0, y);
       if (in.normal.attached()) {
         for (int i = 0; i < count; ++i) {
-          const int fx = int(chosen[i] % size_t(full.width()));
-          const int fy = int(chosen[i] / size_t(full.width()));
-          const float* p = in.normal.pixel(fx, fy);
+          const float* p = in.normal.pixel(chosen_x[i], chosen_y[i]);
           nx[i] = p[0], ny[i] = p[1], nz[i] = p[2];
         }
       }
@@ -237,8 +259,7 @@ void Frame::downsample(const Frame& full, const FrameInputs& in, TilePool& pool,
         if (depth_[row + i] == kBackground) {
           normal_[row + i] = facing;
         } else if (!usable[i]) {
-          normal_[row + i] = encode_normal(full.reconstructed_normal(
-              int(chosen[i] % size_t(full.width())), int(chosen[i] / size_t(full.width()))));
+          normal_[row + i] = encode_normal(full.reconstructed_normal(chosen_x[i], chosen_y[i]));
         }
       }
     }

@@ -120,6 +120,8 @@ class Frame {
  private:
   Vec3 reconstructed_normal(int x, int y) const;
   void build_normals(const FrameInputs& in, TilePool& pool, Progress& progress);
+  static void nearest_of_blocks(const float* top, const float* bottom, int count, float* depth,
+                                int32_t* corner);
   void depth_row(float* depth, int x0, int count, float v, bool radial, float limit) const;
   void encode_normal_row(const float* rotation, float v, int x0, int count, const float* nx,
                          const float* ny, const float* nz, uint32_t* usable, uint32_t* out) const;
