@@ -232,10 +232,16 @@ HWY_AFTER_NAMESPACE();
 #include <vector>
 
 #include "variant.h"
+#include "variants/simd_dispatch.h"
 
 namespace ssao {
-HWY_EXPORT(hemisphere_row);
 namespace {
+
+// The widest compiled hemisphere_row this CPU runs (simd_dispatch.h), chosen on first use.
+decltype(&HWY_STATIC_DISPATCH(hemisphere_row)) best_hemisphere_row() {
+  static const auto row = SSAO_BEST_TARGET(hemisphere_row);
+  return row;
+}
 
 class Hemisphere final : public Variant {
  public:
@@ -289,7 +295,7 @@ class Hemisphere final : public Variant {
         bias_ * radius_, thickness_,          f.pixel_count(),         directions_,
         steps_,          lane_offsets_.data()};
     for (int y = t.y0; y < t.y1; ++y) {
-      HWY_DYNAMIC_DISPATCH(hemisphere_row)(args, y, t.x0, t.x1, visibility + f.index(t.x0, y));
+      best_hemisphere_row()(args, y, t.x0, t.x1, visibility + f.index(t.x0, y));
     }
   }
 

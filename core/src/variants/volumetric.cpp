@@ -233,10 +233,16 @@ HWY_AFTER_NAMESPACE();
 #include <vector>
 
 #include "variant.h"
+#include "variants/simd_dispatch.h"
 
 namespace ssao {
-HWY_EXPORT(volumetric_row);
 namespace {
+
+// The widest compiled volumetric_row this CPU runs (simd_dispatch.h), chosen on first use.
+decltype(&HWY_STATIC_DISPATCH(volumetric_row)) best_volumetric_row() {
+  static const auto row = SSAO_BEST_TARGET(volumetric_row);
+  return row;
+}
 
 using volumetric::kLaneTable;
 
@@ -280,7 +286,7 @@ class Volumetric final : public Variant {
                                  f.camera().intrinsics(), radius_,          thickness_, pairs_,
                                  lane_disk_.data()};
     for (int y = t.y0; y < t.y1; ++y) {
-      HWY_DYNAMIC_DISPATCH(volumetric_row)(args, y, t.x0, t.x1, visibility + f.index(t.x0, y));
+      best_volumetric_row()(args, y, t.x0, t.x1, visibility + f.index(t.x0, y));
     }
   }
 
