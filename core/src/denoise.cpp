@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "scratch.h"
 #include "simd.h"
 
 namespace ssao {
@@ -57,7 +58,7 @@ SSAO_VECTORIZE void fill_geometry_row(const CameraIntrinsics cam, float max_scal
 // pixels outside the image are not geometry. Also the bilateral's plane scale per pixel.
 struct GeometryBlock {
   int x0, y0, width, height;
-  std::vector<float> px, py, pz, nx, ny, nz, valid, inv_scale;
+  ScratchVector<float> px, py, pz, nx, ny, nz, valid, inv_scale;
 
   GeometryBlock(const Frame& f, float radius, int x0_, int y0_, int x1, int y1)
       : x0(x0_), y0(y0_), width(x1 - x0_), height(y1 - y0_) {
@@ -229,8 +230,8 @@ void Denoiser::horizontal_pass(float* visibility, TilePool& pool, Progress& prog
     if (!f_.has_geometry(0, t.y0, width, t.y1)) return;  // sky keeps its value
     const GeometryBlock g(f_, radius_, -kApron, t.y0, width + kApron, t.y1);
     // The row with an apron of background on either side, and its filtered copy.
-    std::vector<float> row(size_t(width) + 2 * kApron, 1.0f);
-    std::vector<float> filtered(static_cast<size_t>(width));
+    ScratchVector<float> row(size_t(width) + 2 * kApron, 1.0f);
+    ScratchVector<float> filtered(static_cast<size_t>(width));
     for (int y = t.y0; y < t.y1; ++y) {
       float* line = visibility + f_.index(0, y);
       std::copy(line, line + width, row.begin() + kApron);
@@ -250,7 +251,7 @@ void Denoiser::vertical_pass(const float* visibility, const Tile& t, float* out)
   }
   const GeometryBlock g(f_, radius_, t.x0, t.y0 - kApron, t.x1, t.y1 + kApron);
   // Rows outside the image are not geometry (weight 0); their values are a placeholder 1.
-  std::vector<float> column_apron(size_t(width) * (t.y1 - t.y0 + 2 * kApron), 1.0f);
+  ScratchVector<float> column_apron(size_t(width) * (t.y1 - t.y0 + 2 * kApron), 1.0f);
   for (int y = t.y0 - kApron; y < t.y1 + kApron; ++y) {
     if (y < 0 || y >= f_.height()) continue;
     std::copy_n(visibility + f_.index(t.x0, y), width,
@@ -276,17 +277,17 @@ void upsample(const Frame& full, const Frame& half, const float* half_visibility
   // over the image less, for the few rows two tiles both read.
   const Tile read{std::max(half_x0, 0), low_row0, std::min(half_x1, half.width()), high_row1};
   const int read_width = read.x1 - read.x0;
-  std::vector<float> filtered(size_t(read_width) * size_t(read.y1 - read.y0));
+  ScratchVector<float> filtered(size_t(read_width) * size_t(read.y1 - read.y0));
   vertical.vertical_pass(half_visibility, read, filtered.data());
-  std::vector<float> values(size_t(half_x1 - half_x0) * size_t(high_row1 - low_row0), 1.0f);
+  ScratchVector<float> values(size_t(half_x1 - half_x0) * size_t(high_row1 - low_row0), 1.0f);
   for (int y = read.y0; y < read.y1; ++y) {
     std::copy_n(filtered.data() + size_t(y - read.y0) * read_width, read_width,
                 values.data() + around.at(read.x0, y));
   }
   const size_t per_parity = size_t(width) / 2 + 1;
-  std::vector<float> by_parity[2] = {std::vector<float>(per_parity),
-                                     std::vector<float>(per_parity)};
-  std::vector<float> depth_of_parity(per_parity);
+  ScratchVector<float> by_parity[2] = {ScratchVector<float>(per_parity),
+                                       ScratchVector<float>(per_parity)};
+  ScratchVector<float> depth_of_parity(per_parity);
   for (int y = t.y0; y < t.y1; ++y) {
     const int low_raw = (y - 1) >> 1;
     const int low = std::max(low_raw, 0), high = std::min(low_raw + 1, half.height() - 1);

@@ -6,6 +6,7 @@
 #include <string>
 
 #include "error.h"
+#include "scratch.h"
 #include "simd.h"
 
 namespace ssao {
@@ -97,8 +98,8 @@ void Frame::build_normals(const FrameInputs& in, TilePool& pool, Progress& progr
       for (int y = t.y0; y < t.y1; ++y) std::fill_n(normal_.data() + index(t.x0, y), count, facing);
       return;
     }
-    std::vector<float> nx(count, 0.0f), ny(count, 0.0f), nz(count, 0.0f);
-    std::vector<uint32_t> usable(count);
+    ScratchVector<float> nx(count, 0.0f), ny(count, 0.0f), nz(count, 0.0f);
+    ScratchVector<uint32_t> usable(count);
     for (int y = t.y0; y < t.y1; ++y) {
       if (in.normal.attached()) {
         for (int i = 0; i < count; ++i) {
@@ -213,9 +214,9 @@ void Frame::downsample(const Frame& full, const FrameInputs& in, TilePool& pool,
   const uint32_t facing = encode_normal({0.0f, 0.0f, 1.0f});
   pool.for_each_tile(width_, height_, progress, [&](const Tile& t) {
     const int count = t.x1 - t.x0;
-    std::vector<float> nx(count, 0.0f), ny(count, 0.0f), nz(count, 0.0f);
-    std::vector<uint32_t> usable(count);
-    std::vector<int32_t> corner(count), chosen_x(count), chosen_y(count);
+    ScratchVector<float> nx(count, 0.0f), ny(count, 0.0f), nz(count, 0.0f);
+    ScratchVector<uint32_t> usable(count);
+    ScratchVector<int32_t> corner(count), chosen_x(count), chosen_y(count);
     for (int y = t.y0; y < t.y1; ++y) {
       // The nearest pixel of each block: thin foreground survives, and a block on a silhouette
       // takes one surface's depth and normal, never a blend of two. A last row or column past

@@ -12,6 +12,7 @@
 #include "denoise.h"
 #include "error.h"
 #include "frame.h"
+#include "scratch.h"
 #include "simd.h"
 #include "variants/variant.h"
 
@@ -444,7 +445,7 @@ void Job::run() {
   const int dx = window.x0, dy = window.y0;  // output pixel (x - dx, y - dy) is frame pixel (x, y)
   tiles.for_each_tile(window.x1 - dx, window.y1 - dy, uncancellable, [&](const Tile& output) {
     const Tile t{output.x0 + dx, output.y0 + dy, output.x1 + dx, output.y1 + dy};
-    std::vector<float> denoised(size_t(t.x1 - t.x0) * size_t(t.y1 - t.y0));
+    ScratchVector<float> denoised(size_t(t.x1 - t.x0) * size_t(t.y1 - t.y0));
     if (!frame.has_geometry(t.x0, t.y0, t.x1, t.y1)) {
       std::fill(denoised.begin(), denoised.end(), 1.0f);  // sky
     } else if (half_resolution) {
