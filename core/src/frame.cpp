@@ -46,6 +46,15 @@ float Frame::solid_entry(int x, int y, float depth, bool& closed) const {
   return entered ? entry : kBackground;  // behind the last known hit
 }
 
+bool Frame::beside_background(int x, int y) const {
+  for (int ny = std::max(y - 1, 0); ny <= std::min(y + 1, height_ - 1); ++ny) {
+    for (int nx = std::max(x - 1, 0); nx <= std::min(x + 1, width_ - 1); ++nx) {
+      if (!is_geometry(nx, ny)) return true;
+    }
+  }
+  return false;
+}
+
 bool Frame::has_geometry(int x0, int y0, int x1, int y1) const {
   for (int y = y0; y < y1; ++y) {
     for (int x = x0; x < x1; ++x) {

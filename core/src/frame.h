@@ -100,6 +100,9 @@ class Frame {
   Vec3 normal(int x, int y) const { return decode_normal(normal_[index(x, y)]); }
   const uint32_t* normal_plane() const { return normal_.data(); }
 
+  // Whether one of the (up to 8) pixels around (x, y) is background.
+  bool beside_background(int x, int y) const;
+
   // Whether rows [y0, y1) x columns [x0, x1) show any geometry (false: all sky).
   bool has_geometry(int x0, int y0, int x1, int y1) const;
 

@@ -105,11 +105,12 @@ void write_ao_row(const float* ao, int count, const ImageView& out, int x, int y
   }
 }
 
-// The composite of pixels [x, x + count) of row y: the beauty times AO, or, with an ambient
-// image, the beauty less the occluded share of the ambient light (never below 0 where the beauty
-// is not). Colour channels only; alpha is copied.
-void composite_row(const float* ao, int count, const ImageView& beauty, const ImageView& ambient,
-                   const ImageView& out, int x, int y) {
+// The composite of pixels [x, x + count) of row y: the beauty darkened on the share c of each
+// pixel that the surface covers, beauty x (1 - c (1 - AO)), or, with an ambient image, the beauty
+// less c (1 - AO) of the ambient light (never below 0 where the beauty is not). Colour channels
+// only; alpha is copied. coverage[i] is c.
+void composite_row(const float* ao, const float* coverage, int count, const ImageView& beauty,
+                   const ImageView& ambient, const ImageView& out, int x, int y) {
   const float* src = beauty.pixel(x, y);
   float* dst = out.pixel(x, y);
   const std::ptrdiff_t src_step = beauty.pixel_stride / std::ptrdiff_t(sizeof(float));
@@ -119,8 +120,9 @@ void composite_row(const float* ao, int count, const ImageView& beauty, const Im
     const float* light = ambient.pixel(x, y);
     const std::ptrdiff_t light_step = ambient.pixel_stride / std::ptrdiff_t(sizeof(float));
     for (int i = 0; i < count; ++i, src += src_step, dst += dst_step, light += light_step) {
+      const float occluded = coverage[i] * (1.0f - ao[i]);
       for (int c = 0; c < colour; ++c) {
-        const float darker = src[c] - (1.0f - ao[i]) * light[c];
+        const float darker = src[c] - occluded * light[c];
         dst[c] = darker < 0.0f && src[c] >= 0.0f ? 0.0f : darker;
       }
       for (int c = colour; c < channels; ++c) dst[c] = src[c];
@@ -128,8 +130,32 @@ void composite_row(const float* ao, int count, const ImageView& beauty, const Im
     return;
   }
   for (int i = 0; i < count; ++i, src += src_step, dst += dst_step) {
-    for (int c = 0; c < colour; ++c) dst[c] = src[c] * ao[i];
+    const float factor = 1.0f - coverage[i] * (1.0f - ao[i]);
+    for (int c = 0; c < colour; ++c) dst[c] = src[c] * factor;
     for (int c = colour; c < channels; ++c) dst[c] = src[c];
+  }
+}
+
+// The share of pixels [x0, x1) of frame row y that the surface covers, for the composite. 1
+// except on geometry pixels beside the background: there an anti-aliased normal pass is the
+// average of the surface's unit normals and the sky's zeros, so its length is the surface's
+// share of the pixel. A beauty with alpha below 1 (a transparent film) holds only what is not
+// transparent, premultiplied: the surface's share of that is length / alpha. Normals from
+// elsewhere than a pass (reconstructed) say nothing: 1.
+void coverage_row(const Frame& frame, const ImageView& normal, const ImageView& beauty, int x0,
+                  int x1, int y, int dx, int dy, float* coverage) {
+  for (int x = x0; x < x1; ++x) {
+    float c = 1.0f;
+    if (normal.attached() && frame.is_geometry(x, y) && frame.beside_background(x, y)) {
+      const float* n = normal.pixel(x, y);
+      const float length = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+      c = length < 1.0f ? length : 1.0f;  // NaN fails the test: 1
+      if (beauty.channels == 4) {
+        const float alpha = beauty.pixel(x - dx, y - dy)[3];
+        if (alpha > 0.0f && alpha < 1.0f) c = c < alpha ? c / alpha : 1.0f;
+      }
+    }
+    coverage[x - x0] = c;
   }
 }
 
@@ -446,6 +472,7 @@ void Job::run() {
   tiles.for_each_tile(window.x1 - dx, window.y1 - dy, uncancellable, [&](const Tile& output) {
     const Tile t{output.x0 + dx, output.y0 + dy, output.x1 + dx, output.y1 + dy};
     ScratchVector<float> denoised(size_t(t.x1 - t.x0) * size_t(t.y1 - t.y0));
+    ScratchVector<float> coverage(composite_out_.attached() ? size_t(t.x1 - t.x0) : 0);
     if (!frame.has_geometry(t.x0, t.y0, t.x1, t.y1)) {
       std::fill(denoised.begin(), denoised.end(), 1.0f);  // sky
     } else if (half_resolution) {
@@ -459,7 +486,9 @@ void Job::run() {
       shaping.apply(frame.depth_plane() + frame.index(t.x0, y), values, count);
       if (ao_out_.attached()) write_ao_row(values, count, ao_out_, t.x0 - dx, y - dy);
       if (composite_out_.attached()) {
-        composite_row(values, count, beauty_, ambient_, composite_out_, t.x0 - dx, y - dy);
+        coverage_row(frame, normal_, beauty_, t.x0, t.x1, y, dx, dy, coverage.data());
+        composite_row(values, coverage.data(), count, beauty_, ambient_, composite_out_, t.x0 - dx,
+                      y - dy);
       }
     }
   });

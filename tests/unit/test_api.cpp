@@ -282,6 +282,69 @@ TEST(Api, CompositeIsBeautyTimesAoAndMayBeInPlace) {
   }
 }
 
+// A pixel partly covered by sky: the normal pass averages the surface's unit normals with the
+// sky's zeros, so its length is the surface's share c, and the composite darkens that share
+// only, beauty x (1 - c (1 - AO)); with a transparent film (alpha c) the beauty holds only the
+// surface, which AO darkens whole. The AO output does not change.
+TEST(Api, CompositeDarkensOnlyTheSurfacesShareBesideTheSky) {
+  const Camera cam;
+  Scene s = floor_and_wall(cam);
+  const int w = s.width, h = s.height;
+  // Sky above the row just over the crease, where the floor occludes the wall.
+  const auto full = compute_ao(s, cam, 1.0, "hemisphere");
+  int sky_rows = 1;
+  double darkest = 2.0;
+  for (int y = 1; y < h; ++y) {
+    double sum = 0.0;
+    for (int x = 0; x < w; ++x) sum += full[size_t(y) * w + x];
+    if (sum / w < darkest) darkest = sum / w, sky_rows = y - 1;
+  }
+  ASSERT_GT(sky_rows, 0);
+  for (int y = 0; y < sky_rows; ++y) {
+    for (int x = 0; x < w; ++x) {
+      s.depth[size_t(y) * w + x] = std::numeric_limits<float>::infinity();
+      for (int c = 0; c < 3; ++c) s.normal[(size_t(y) * w + x) * 3 + c] = 0.0f;
+    }
+  }
+  // The first surface row is anti-aliased against the sky: a quarter, half or all covered.
+  const auto share = [](int x) { return x % 3 == 0 ? 0.25f : (x % 3 == 1 ? 0.5f : 1.0f); };
+  const size_t edge = size_t(sky_rows) * w;
+  for (int x = 0; x < w; ++x) {
+    for (int c = 0; c < 3; ++c) s.normal[(edge + x) * 3 + c] *= share(x);
+  }
+  const auto ao = compute_ao(s, cam, 1.0, "hemisphere");
+  for (const int channels : {3, 4}) {
+    std::vector<float> beauty(size_t(w) * h * channels, 0.8f), composite(beauty.size(), -1.0f);
+    if (channels == 4) {  // transparent film: alpha is the coverage
+      for (size_t i = 0; i < size_t(w) * h; ++i) beauty[i * 4 + 3] = 1.0f;
+      for (int x = 0; x < w; ++x) beauty[(edge + x) * 4 + 3] = share(x);
+    }
+    std::vector<float> ao_out(size_t(w) * h, -1.0f);
+    Job job;
+    job.camera(cam);
+    job.set("radius", 1.0);
+    job.set("normal_space", "camera");
+    job.image("depth", s.depth, w, h, 1);
+    job.image("normal", s.normal, w, h, 3);
+    job.image("beauty", beauty, w, h, channels);
+    job.image("composite", composite, w, h, channels);
+    job.image("ao", ao_out, w, h, 1);
+    ASSERT_EQ(job.run(), SSAO_OK) << ssao_last_error();
+    EXPECT_EQ(ao_out, ao);
+    int partial = 0;
+    for (size_t i = edge - w; i < size_t(w) * h; ++i) {
+      const int x = int(i % size_t(w));
+      const float c = i >= edge && i < edge + w && channels == 3 ? share(x) : 1.0f;
+      const float expected = i < edge ? 0.8f : 0.8f * (1.0f - c * (1.0f - ao[i]));
+      ASSERT_NEAR(composite[i * channels], expected, 1e-6f) << "pixel " << i << ", " << channels;
+      partial += c < 1.0f && ao[i] < 0.99f;
+    }
+    if (channels == 3) {
+      EXPECT_GT(partial, w / 2);  // the edge row is occluded: the test bites
+    }
+  }
+}
+
 TEST(Api, AmbientCompositeDarkensOnlyTheAmbientPart) {
   const Camera cam;
   Scene s = floor_and_wall(cam);

@@ -145,7 +145,13 @@ SSAO_API ssao_status ssao_job_get_floats(ssao_job job, const char* name, double*
  *   "composite" output: beauty with its first min(channels,3) channels multiplied by AO, or,
  *               with "ambient", beauty - (1 - AO) x ambient (not below 0 where the beauty is
  *               not); the rest copied; needs as many channels as "beauty" (may be the beauty
- *               buffer itself)
+ *               buffer itself). On a silhouette against the background only the surface's
+ *               share c of the pixel is darkened: beauty x (1 - c (1 - AO)) (ambient: c (1 -
+ *               AO) x ambient), c the length of the "normal" image's vector (an anti-aliased
+ *               normal pass averages the surface's unit normals with the background's zeros),
+ *               divided by the beauty's alpha (channel 3) when that is below 1 (a transparent
+ *               film: the beauty holds only the surface's light); c = 1 elsewhere, and
+ *               without a normal image. The "ao" output is not changed by it.
  *   "depth2" ... "depth5"
  *               input, optional, channel 0 read: extra depth layers, the depth of the 2nd, 3rd,
  *               ... surface hit along each pixel's ray, in "depth"'s convention (a background
