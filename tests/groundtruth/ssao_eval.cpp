@@ -58,12 +58,13 @@ const char* const kUsage =
     "Scores AO methods against the ray-traced AO pass (<layer>.AO.R) of a Blender multilayer\n"
     "EXR with Depth (and optionally Normal) passes. Prints one line per method:\n"
     "  scene=... method=... settings=... normals=pass|depth rmse=... mean_error=... time_ms=...\n"
-    "  min_ms=... repeat=N threads=T pixels=P\n"
+    "  min_ms=... repeat=N threads=T pixels=P rmse_interior=... interior_pixels=P\n"
     "over the pixels whose depth is finite, > 0 and < 0.9 * clip_end. mean_error is the mean\n"
     "of (method - truth): positive means too little occlusion. time_ms is the median of\n"
     "--repeat runs of the AO computation alone (no file I/O), min_ms the fastest; the methods\n"
     "run in interleaved rounds (A B C A B C ...) after one untimed round. An image method is\n"
-    "not timed (nan).\n"
+    "not timed (nan). rmse_interior leaves out the pixels beside one outside that set: on a\n"
+    "silhouette against the sky Cycles' pass reads coverage x AO (sky samples add nothing).\n"
     "\n"
     "Methods:\n"
     "  ssao             libssao through its C API; world-space normals from the Normal pass\n"
@@ -790,7 +791,19 @@ struct Score {
   double rmse = 0.0;
   double mean_error = 0.0;
   size_t pixels = 0;
+  double rmse_interior = 0.0;  // over the scored pixels none of whose 8 neighbours is unscored
+  size_t interior_pixels = 0;
 };
+
+// Whether every pixel around (x, y) inside the image is scored.
+bool interior(const Scene& s, int x, int y) {
+  for (int ny = std::max(y - 1, 0); ny <= std::min(y + 1, s.height - 1); ++ny) {
+    for (int nx = std::max(x - 1, 0); nx <= std::min(x + 1, s.width - 1); ++nx) {
+      if (!s.mask[static_cast<size_t>(ny) * static_cast<size_t>(s.width) + nx]) return false;
+    }
+  }
+  return true;
+}
 
 Score score(const Scene& s, const Method& m) {
   const std::vector<float>& ao = *m.ao;
@@ -799,7 +812,7 @@ Score score(const Scene& s, const Method& m) {
                            std::to_string(s.truth.size()));
   }
   Score sc;
-  double sum = 0.0, sum_sq = 0.0;
+  double sum = 0.0, sum_sq = 0.0, interior_sq = 0.0;
   for (int y = std::max(0, m.window.y0); y < std::min(s.height, m.window.y1); ++y) {
     for (int x = std::max(0, m.window.x0); x < std::min(s.width, m.window.x1); ++x) {
       const size_t p = static_cast<size_t>(y) * static_cast<size_t>(s.width) + x;
@@ -808,8 +821,12 @@ Score score(const Scene& s, const Method& m) {
       sum += diff;
       sum_sq += diff * diff;
       ++sc.pixels;
+      if (interior(s, x, y)) interior_sq += diff * diff, ++sc.interior_pixels;
     }
   }
+  sc.rmse_interior = sc.interior_pixels > 0
+                         ? std::sqrt(interior_sq / static_cast<double>(sc.interior_pixels))
+                         : std::numeric_limits<double>::quiet_NaN();
   if (sc.pixels == 0) throw ssao_io::Error(m.name + " " + m.settings + ": no pixel to score");
   const double n = static_cast<double>(sc.pixels);
   sc.rmse = std::sqrt(sum_sq / n);
@@ -823,9 +840,11 @@ Score report(const Scene& s, const Options& o, const Method& m, const std::vecto
                                    : *std::min_element(ms.begin(), ms.end());
   std::printf(
       "scene=%s method=%s settings=%s normals=%s rmse=%.5f mean_error=%+.5f "
-      "time_ms=%.2f min_ms=%.2f repeat=%d threads=%d pixels=%zu\n",
+      "time_ms=%.2f min_ms=%.2f repeat=%d threads=%d pixels=%zu rmse_interior=%.5f "
+      "interior_pixels=%zu\n",
       s.name.c_str(), m.name.c_str(), m.settings.c_str(), s.world_normal.empty() ? "depth" : "pass",
-      sc.rmse, sc.mean_error, median(ms), min_ms, o.repeat, m.threads, sc.pixels);
+      sc.rmse, sc.mean_error, median(ms), min_ms, o.repeat, m.threads, sc.pixels, sc.rmse_interior,
+      sc.interior_pixels);
   std::fflush(stdout);
   return sc;
 }
