@@ -233,7 +233,8 @@ extern const VariantInfo kHorizonVariant;
 const VariantInfo kHorizonVariant = {
     "horizon",
     "horizon-based (GTAO) slices with a visibility bitmask: cosine-weighted like Cycles' AO, "
-    "thin occluders do not hide what is behind them",
+    "thin occluders do not hide what is behind them; kept for comparison (slower and, but for "
+    "thin occluders, less accurate than hemisphere: docs/variants.md)",
     "slices|steps|thickness|bias|seed",
     [](const ParamValues& v, const Frame&) -> std::unique_ptr<Variant> {
       return std::make_unique<Horizon>(v);
