@@ -56,7 +56,7 @@ const std::vector<ssao_param_desc>& table() {
       float_param("bias", 0.02, 0.0, 1.0, "fraction of radius",
                   "height above the receiver's tangent plane (hemisphere, horizon) or behind the "
                   "sample (sphere) an occluder needs to count; one pixel footprint is added"),
-      float_param("sample_clustering", 0.6, 0.0, 4.0, "exponent",
+      float_param("sample_clustering", 1.0, 0.0, 4.0, "exponent",
                   "samples sit at radius * lerp(0.1, 1, s^p) for s uniform in [0,1): 0 puts all "
                   "on the kernel's surface, 2 clusters them toward the centre as the seed code "
                   "does (measured)"),

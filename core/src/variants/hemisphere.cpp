@@ -247,7 +247,7 @@ class Hemisphere final : public Variant {
  public:
   explicit Hemisphere(const ParamValues& v) {
     static constexpr int kSamples[4] = {4, 4, 8, 16};
-    static constexpr int kSteps[4] = {4, 7, 7, 8};
+    static constexpr int kSteps[4] = {4, 6, 6, 6};
     radius_ = float(v.get_float("radius"));
     bias_ = float(v.get_float("bias"));
     thickness_ = float(v.get_float("thickness")) * radius_;
