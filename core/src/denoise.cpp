@@ -264,6 +264,18 @@ void Denoiser::vertical_pass(const float* visibility, const Tile& t, float* out)
   }
 }
 
+// in[0], in[2], ... in[2 (count - 1)] into out[0 .. count): a loop the compiler vectorises.
+SSAO_VECTORIZE void every_other(const float* __restrict in, int count, float* __restrict out) {
+  for (int k = 0; k < count; ++k) out[k] = in[2 * k];
+}
+
+// out[2 k] = first[k], out[2 k + 1] = second[k], for the `count` values of out.
+SSAO_VECTORIZE void interleave(const float* __restrict first, const float* __restrict second,
+                               int count, float* __restrict out) {
+  for (int k = 0; k < count / 2; ++k) out[2 * k] = first[k], out[2 * k + 1] = second[k];
+  if (count % 2 != 0) out[count - 1] = first[count / 2];
+}
+
 void upsample(const Frame& full, const Frame& half, const float* half_visibility,
               const Denoiser& vertical, float radius, const Tile& t, float* out) {
   const int width = t.x1 - t.x0;
@@ -297,16 +309,15 @@ void upsample(const Frame& full, const Frame& half, const float* half_visibility
       const int count = x_first < t.x1 ? (t.x1 - x_first + 1) / 2 : 0;
       if (count == 0) continue;
       const int k0 = x_first >> 1;
-      const float* depth = full.depth_plane() + full.index(x_first, y);
-      for (int k = 0; k < count; ++k) depth_of_parity[size_t(k)] = depth[2 * k];
+      every_other(full.depth_plane() + full.index(x_first, y), count, depth_of_parity.data());
       upsample_run(full.camera().intrinsics(), 0.1f * radius, depth_of_parity.data(),
                    float(x_first) + 0.5f, float(y) + 0.5f,
                    row_planes(around, k0, low, &values[around.at(k0, low)]),
                    row_planes(around, k0, high, &values[around.at(k0, high)]),
                    (y & 1) ? 0.25f : 0.75f, parity, count, by_parity[parity].data());
-      float* row = out + size_t(y - t.y0) * width;
-      for (int k = 0; k < count; ++k) row[x_first + 2 * k - t.x0] = by_parity[parity][k];
     }
+    interleave(by_parity[(t.x0 & 1) != 0].data(), by_parity[(t.x0 & 1) == 0].data(), width,
+               out + size_t(y - t.y0) * width);
   }
 }
 

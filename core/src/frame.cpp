@@ -88,7 +88,7 @@ void Frame::build_depth(const FrameInputs& in, TilePool& pool, Progress& progres
   pool.for_each_tile(width_, height_, progress, [&](const Tile& t) {
     for (int y = t.y0; y < t.y1; ++y) {
       float* row = depth_.data() + index(t.x0, y);
-      for (int x = t.x0; x < t.x1; ++x) row[x - t.x0] = in.depth.pixel(x, y)[0];
+      in.depth.read_channel0(t.x0, y, t.x1 - t.x0, row);
       depth_row(row, t.x0, t.x1 - t.x0, float(y) + 0.5f, in.radial_depth, limit);
       for (int k = 0; k < extra_layers_; ++k) layer_row(in, k, t.x0, t.x1 - t.x0, y, limit);
     }
@@ -168,7 +168,7 @@ SSAO_VECTORIZE void Frame::encode_normal_row(const float* rotation, float v, int
 void Frame::layer_row(const FrameInputs& in, int k, int x0, int count, int y, float limit) {
   float* row = layers_.data() + size_t(k) * pixel_count() + index(x0, y);
   const float* before = k == 0 ? depth_.data() + index(x0, y) : row - pixel_count();
-  for (int i = 0; i < count; ++i) row[i] = in.layers[k].pixel(x0 + i, y)[0];
+  in.layers[k].read_channel0(x0, y, count, row);
   depth_row(row, x0, count, float(y) + 0.5f, in.radial_depth, limit);
   const bool alternating_back = k % 2 == 0;
   for (int i = 0; i < count; ++i) {

@@ -2,6 +2,7 @@
 // A caller-owned float image with byte strides (see the conventions in ssao.h).
 #pragma once
 
+#include <algorithm>
 #include <cstddef>
 
 namespace ssao {
@@ -15,6 +16,16 @@ struct ImageView {
   float* pixel(int x, int y) const {
     return reinterpret_cast<float*>(reinterpret_cast<char*>(data) + y * row_stride +
                                     x * pixel_stride);
+  }
+  // Channel 0 of pixels [x, x + count) of row y into out (one copy when the channel is packed).
+  void read_channel0(int x, int y, int count, float* out) const {
+    const float* p = pixel(x, y);
+    const std::ptrdiff_t step = pixel_stride / std::ptrdiff_t(sizeof(float));
+    if (step == 1) {
+      std::copy_n(p, count, out);
+      return;
+    }
+    for (int i = 0; i < count; ++i, p += step) out[i] = p[0];
   }
 };
 
