@@ -60,6 +60,9 @@ LIBRARY_FULL = [
     # The default of 45f8526, before the presets: the accuracy the default must keep.
     ("hemisphere", "samples=16,steps=6,clustering=1",
      ["samples=16", "steps=6", "sample_clustering=1"]),
+    # The medium preset from f463daf to issue 22 (tuned on this kit; docs/variants.md).
+    ("hemisphere", "samples=4,steps=7,clustering=0.6",
+     ["samples=4", "steps=7", "sample_clustering=0.6"]),
     ("horizon", "quality=low", ["variant=horizon", "quality=low"]),
     ("horizon", "quality=medium", ["variant=horizon"]),
     ("horizon", "quality=high", ["variant=horizon", "quality=high"]),
