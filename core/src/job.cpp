@@ -130,7 +130,8 @@ void composite_row(const float* ao, const float* coverage, int count, const Imag
     return;
   }
   for (int i = 0; i < count; ++i, src += src_step, dst += dst_step) {
-    const float factor = 1.0f - coverage[i] * (1.0f - ao[i]);
+    // AO itself where the pixel is covered: 1 - (1 - AO) need not round back to AO.
+    const float factor = coverage[i] < 1.0f ? 1.0f - coverage[i] * (1.0f - ao[i]) : ao[i];
     for (int c = 0; c < colour; ++c) dst[c] = src[c] * factor;
     for (int c = colour; c < channels; ++c) dst[c] = src[c];
   }
