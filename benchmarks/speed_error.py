@@ -300,8 +300,22 @@ def measure_scene(args, plan, reference, scene, size, sweeps, layers=None):
                             ("image", ["path=" + run["file"]])))
     log("library: %s, %d configurations x %d run(s), and %d Cycles images"
         % (label(scene, size), timed, plan.repeat, len(entries) - timed))
-    results = run_eval(args, reference, [run for _, run in entries], plan.repeat,
-                       label(scene, size), layers)
+    try:
+        results = run_eval(args, reference, [run for _, run in entries], plan.repeat,
+                           label(scene, size), layers)
+    except StepFailed as error:
+        if not layers:
+            raise
+        # A layers file the library refuses (a hit nearer than the reference's depth: the
+        # helper render's first hit can differ from the reference's sample 0 on a silhouette)
+        # costs the layer rows only, not the scene.
+        log("layers refused on %s, measured without the layer rows: %s"
+            % (label(scene, size), str(error).splitlines()[-1]))
+        entries = [entry for entry in entries
+                   if (entry[0]["method"], entry[0]["setting"]) not in
+                   {(method, setting) for method, setting, _ in LAYER_ROWS}]
+        results = run_eval(args, reference, [run for _, run in entries], plan.repeat,
+                           label(scene, size))
     rows = []
     for (known, _), result in zip(entries, results):
         row = {"scene": label(scene, size), "time_s": float(result["time_ms"]) / 1000.0,
