@@ -4,7 +4,7 @@
 // next tile and the next run. With the C library's malloc, a run's freed scratch went back to
 // the system (heap trims and madvise, each a TLB shootdown across the pool's threads) and came
 // back as page faults in the next run: about 1,100 page faults and several ms of system time per
-// 640x360 run (getrusage, docs/performance.md "Cold start").
+// 640x360 run (getrusage, docs/architecture.md "Cold start").
 #pragma once
 
 #include <tbb/scalable_allocator.h>

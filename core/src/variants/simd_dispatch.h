@@ -2,8 +2,8 @@
 // Picks, once per process, the widest of the SIMD targets Highway compiled a kernel for that
 // this CPU runs: what HWY_DYNAMIC_DISPATCH does, without libhwy.so. Loading libhwy.so (1.0.3,
 // Debian 12) runs a timer calibration in a static initialiser: 5.9 ms of every process that
-// loads libssao (benchmarks/cold_start.c, docs/performance.md), for a dispatch that needs only
-// cpuid. The kernels themselves still come from Highway's headers.
+// loads libssao (benchmarks/cold_start.c, docs/architecture.md "Cold start"), for a dispatch that
+// needs only cpuid. The kernels themselves still come from Highway's headers.
 //
 // Use inside namespace ssao, after the per-target part of a foreach_target file:
 //   static const auto row = SSAO_BEST_TARGET(hemisphere_row);
