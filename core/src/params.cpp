@@ -33,7 +33,7 @@ const std::vector<ssao_param_desc>& table() {
       // --- algorithm ---
       string_param("variant", "hemisphere", "horizon|hemisphere|sphere|volumetric|unsharp",
                    "horizon: horizon-based slices with a visibility bitmask (GTAO), kept for "
-                   "comparison: 5-13x the default's time and less accurate on the benchmark "
+                   "comparison: 7-15x the default's time and less accurate on the benchmark "
                    "scenes but the one with thin occluders (docs/variants.md); hemisphere: "
                    "normal-oriented hemisphere kernel; sphere: Crysis sphere kernel (depth only); "
                    "volumetric: line-integral obscurance of a sphere along view rays (depth "
