@@ -851,7 +851,9 @@ def main():
         " --size %dx%d" % args.size if args.size else "")
     report = (args, plan, rows, table, complexity, noise, machine)
     write_markdown(os.path.join(args.out, "performance.md"), "", *report, command, failed)
-    if args.update_docs:
+    if args.update_docs and failed:
+        log("docs/ left as they were: %s failed" % ", ".join(failed))
+    elif args.update_docs:
         for name in ("speed_error.png", "complexity.png"):
             if os.path.isfile(os.path.join(args.out, name)):
                 shutil.copy(os.path.join(args.out, name), os.path.join(REPO_ROOT, "docs", "images"))
