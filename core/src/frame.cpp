@@ -77,11 +77,16 @@ void normal_rotation(const FrameInputs& in, float rotation[9]) {
 }  // namespace
 
 void Frame::build(const FrameInputs& in, TilePool& pool, Progress& progress) {
-  build_depth(in, pool, progress);
+  fill_depth(in, pool, progress);
   build_normals(in, pool, progress);
 }
 
 void Frame::build_depth(const FrameInputs& in, TilePool& pool, Progress& progress) {
+  fill_depth(in, pool, progress);
+  std::vector<uint32_t>().swap(normal_);  // what a run at full resolution kept
+}
+
+void Frame::fill_depth(const FrameInputs& in, TilePool& pool, Progress& progress) {
   // A depth at or beyond this is background (so are NaN, infinity and depths <= 0).
   const float limit =
       in.clip_end > 0.0f ? std::min(in.background_depth, in.clip_end) : in.background_depth;
@@ -107,26 +112,39 @@ void Frame::build_normals(const FrameInputs& in, TilePool& pool, Progress& progr
       for (int y = t.y0; y < t.y1; ++y) std::fill_n(normal_.data() + index(t.x0, y), count, facing);
       return;
     }
-    ScratchVector<float> nx(count, 0.0f), ny(count, 0.0f), nz(count, 0.0f);
-    ScratchVector<uint32_t> usable(count);
+    NormalRow scratch(count);
     for (int y = t.y0; y < t.y1; ++y) {
-      if (in.normal.attached()) {
-        for (int i = 0; i < count; ++i) {
-          const float* p = in.normal.pixel(t.x0 + i, y);
-          nx[i] = p[0], ny[i] = p[1], nz[i] = p[2];
-        }
-      }
-      const size_t row = index(t.x0, y);
-      encode_normal_row(rotation, float(y) + 0.5f, t.x0, count, nx.data(), ny.data(), nz.data(),
-                        usable.data(), normal_.data() + row);
-      // A missing, zero or non-finite normal (Blender writes 0 on background and blends on
-      // silhouettes) falls back to the depth-reconstructed one.
-      for (int i = 0; i < count; ++i) {
-        if (usable[i] || depth_[row + i] == kBackground) continue;
-        normal_[row + i] = encode_normal(reconstructed_normal(t.x0 + i, y));  // faces the camera
-      }
+      pack_normals_row(in, rotation, *this, nullptr, nullptr, t.x0, y, count, scratch);
     }
   });
+}
+
+Frame::NormalRow::NormalRow(int count)
+    : nx(count, 0.0f), ny(count, 0.0f), nz(count, 0.0f), usable(count) {}
+
+// Normals of pixels [x0, x0 + count) of row y, packed into this frame's plane: the normal
+// image's at (xs[i], ys[i]) of `source`'s pixel grid (this row's own pixels when xs is null),
+// rotated to view space and turned to the camera along this frame's rays. A missing, zero or
+// non-finite normal (Blender writes 0 on background and blends on silhouettes) falls back to
+// the one reconstructed from `source`'s depth, on geometry pixels.
+void Frame::pack_normals_row(const FrameInputs& in, const float* rotation, const Frame& source,
+                             const int32_t* xs, const int32_t* ys, int x0, int y, int count,
+                             NormalRow& scratch) {
+  const auto source_x = [&](int i) { return xs != nullptr ? xs[i] : x0 + i; };
+  const auto source_y = [&](int i) { return ys != nullptr ? ys[i] : y; };
+  if (in.normal.attached()) {
+    for (int i = 0; i < count; ++i) {
+      const float* p = in.normal.pixel(source_x(i), source_y(i));
+      scratch.nx[i] = p[0], scratch.ny[i] = p[1], scratch.nz[i] = p[2];
+    }
+  }
+  const size_t row = index(x0, y);
+  encode_normal_row(rotation, float(y) + 0.5f, x0, count, scratch.nx.data(), scratch.ny.data(),
+                    scratch.nz.data(), scratch.usable.data(), normal_.data() + row);
+  for (int i = 0; i < count; ++i) {
+    if (scratch.usable[i] || depth_[row + i] == kBackground) continue;
+    normal_[row + i] = encode_normal(source.reconstructed_normal(source_x(i), source_y(i)));
+  }
 }
 
 // Normals of one row: rotated to view space, normalised, turned towards the camera (shading
@@ -223,8 +241,7 @@ void Frame::downsample(const Frame& full, const FrameInputs& in, TilePool& pool,
   const uint32_t facing = encode_normal({0.0f, 0.0f, 1.0f});
   pool.for_each_tile(width_, height_, progress, [&](const Tile& t) {
     const int count = t.x1 - t.x0;
-    ScratchVector<float> nx(count, 0.0f), ny(count, 0.0f), nz(count, 0.0f);
-    ScratchVector<uint32_t> usable(count);
+    NormalRow scratch(count);
     ScratchVector<int32_t> corner(count), chosen_x(count), chosen_y(count);
     for (int y = t.y0; y < t.y1; ++y) {
       // The nearest pixel of each block: thin foreground survives, and a block on a silhouette
@@ -256,21 +273,11 @@ void Frame::downsample(const Frame& full, const FrameInputs& in, TilePool& pool,
       // Only the chosen pixels' normals are read and packed: a quarter of the full frame's.
       // They are turned towards the camera along this frame's pixel rays, the rays on which
       // the variants place them.
-      const size_t row = index(t.x0, y);
-      if (in.normal.attached()) {
-        for (int i = 0; i < count; ++i) {
-          const float* p = in.normal.pixel(chosen_x[i], chosen_y[i]);
-          nx[i] = p[0], ny[i] = p[1], nz[i] = p[2];
-        }
-      }
-      encode_normal_row(rotation, float(y) + 0.5f, t.x0, count, nx.data(), ny.data(), nz.data(),
-                        usable.data(), normal_.data() + row);
+      pack_normals_row(in, rotation, full, chosen_x.data(), chosen_y.data(), t.x0, y, count,
+                       scratch);
+      uint32_t* normals = normal_.data() + index(t.x0, y);
       for (int i = 0; i < count; ++i) {
-        if (depth_[row + i] == kBackground) {
-          normal_[row + i] = facing;
-        } else if (!usable[i]) {
-          normal_[row + i] = encode_normal(full.reconstructed_normal(chosen_x[i], chosen_y[i]));
-        }
+        if (depth[i] == kBackground) normals[i] = facing;
       }
     }
   });

@@ -12,6 +12,7 @@
 
 #include "camera.h"
 #include "image_view.h"
+#include "scratch.h"
 #include "tiles.h"
 #include "vec3.h"
 
@@ -77,7 +78,7 @@ class Frame {
   // Fills the depth plane, then the normals (from the normal image or reconstructed from depth).
   void build(const FrameInputs& in, TilePool& pool, Progress& progress);
   // The depth plane (and extra layers) alone: what a frame estimated at half resolution needs
-  // of the full one. Its normal plane is not filled.
+  // of the full one. It has no normal plane (one a previous run kept is freed).
   void build_depth(const FrameInputs& in, TilePool& pool, Progress& progress);
 
   // This frame at half resolution: each 2x2 block becomes one pixel with the depth and normal
@@ -122,7 +123,17 @@ class Frame {
 
  private:
   Vec3 reconstructed_normal(int x, int y) const;
+  void fill_depth(const FrameInputs& in, TilePool& pool, Progress& progress);
   void build_normals(const FrameInputs& in, TilePool& pool, Progress& progress);
+  // A row's normal image values, as planes, before they are packed.
+  struct NormalRow {
+    explicit NormalRow(int count);
+    ScratchVector<float> nx, ny, nz;
+    ScratchVector<uint32_t> usable;
+  };
+  void pack_normals_row(const FrameInputs& in, const float* rotation, const Frame& source,
+                        const int32_t* xs, const int32_t* ys, int x0, int y, int count,
+                        NormalRow& scratch);
   static void nearest_of_blocks(const float* top, const float* bottom, int count, float* depth,
                                 int32_t* corner);
   void depth_row(float* depth, int x0, int count, float v, bool radial, float limit) const;

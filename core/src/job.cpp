@@ -434,7 +434,8 @@ void Job::run() {
   }
   const Frame& seen = half_resolution ? half_frame_ : frame;
   // At most three image-size buffers: the full frame's two planes and one of visibility (or the
-  // half frame's planes and visibility, a quarter each). What the other mode kept is freed.
+  // full frame's depth plane, and the half frame's planes and visibility, a quarter each). What
+  // the other mode kept is freed (build_depth frees the full frame's normal plane).
   if (!half_resolution) half_frame_ = Frame();
   const size_t estimates = size_t(seen.width()) * size_t(seen.height());
   if (visibility_.capacity() > estimates) std::vector<float>().swap(visibility_);
