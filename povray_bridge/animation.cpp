@@ -5,8 +5,8 @@
 #include <cctype>
 #include <cstdlib>
 
-#include "io/frames.h"
-#include "io/param_flags.h"
+#include "tools/frames.h"
+#include "tools/param_flags.h"
 
 namespace povray_ssao {
 namespace {
@@ -104,26 +104,26 @@ bool read_clock_option(const std::string& text, ClockOptions& clock) {
 std::vector<AnimationFrame> animation_frames(const ClockOptions& clock) {
   if (!clock.animated()) return {};
   if (!clock.unreadable.empty()) {
-    throw ssao_io::UsageError(clock.unreadable +
-                              ": povray-ssao takes animation frames as whole frame numbers");
+    throw ssao_tools::UsageError(clock.unreadable +
+                                 ": povray-ssao takes animation frames as whole frame numbers");
   }
   const long first = clock.initial_frame.value_or(1);
   const long last = clock.final_frame.value_or(first);
   if (last < first) {
-    throw ssao_io::UsageError("the animation runs backwards: Final_Frame (+KFF" +
-                              std::to_string(last) + ") is before Initial_Frame (+KFI" +
-                              std::to_string(first) + ")");
+    throw ssao_tools::UsageError("the animation runs backwards: Final_Frame (+KFF" +
+                                 std::to_string(last) + ") is before Initial_Frame (+KFI" +
+                                 std::to_string(first) + ")");
   }
-  if (first < 0) throw ssao_io::UsageError("povray-ssao renders frames numbered from 0 up");
+  if (first < 0) throw ssao_tools::UsageError("povray-ssao renders frames numbered from 0 up");
   const long from = std::max(first, clock.subset_start.value_or(first));
   const long to = std::min(last, clock.subset_end.value_or(last));
   if (to < from) {
-    throw ssao_io::UsageError("the subset of frames (+SF" + std::to_string(from) + " +EF" +
-                              std::to_string(to) + ") holds no frame of " + std::to_string(first) +
-                              ".." + std::to_string(last));
+    throw ssao_tools::UsageError("the subset of frames (+SF" + std::to_string(from) + " +EF" +
+                                 std::to_string(to) + ") holds no frame of " +
+                                 std::to_string(first) + ".." + std::to_string(last));
   }
-  if (static_cast<unsigned long>(to - from) >= ssao_io::kMaxFrames) {
-    throw ssao_io::UsageError("more than " + std::to_string(ssao_io::kMaxFrames) + " frames");
+  if (static_cast<unsigned long>(to - from) >= ssao_tools::kMaxFrames) {
+    throw ssao_tools::UsageError("more than " + std::to_string(ssao_tools::kMaxFrames) + " frames");
   }
   const double span = static_cast<double>(last - first + (clock.cyclic ? 1 : 0));
   const size_t width = std::to_string(last).size();
@@ -142,7 +142,7 @@ std::vector<AnimationFrame> animation_frames(const ClockOptions& clock) {
 }
 
 std::string frame_output(const std::string& path, const AnimationFrame& frame) {
-  const ssao_io::FramePattern pattern(path);
+  const ssao_tools::FramePattern pattern(path);
   if (pattern.has_frame()) return pattern.path(static_cast<int>(frame.number));
   const size_t slash = path.rfind('/');
   const size_t dot = path.rfind('.');

@@ -39,7 +39,7 @@ struct AnimationFrame {
 // frame), limited to Subset_Start_Frame..Subset_End_Frame; clock = Initial_Clock + (Final_Clock -
 // Initial_Clock) (frame - Initial_Frame) / (Final_Frame - Initial_Frame), with one more frame in
 // the divisor for Cyclic_Animation, and Initial_Clock when there is a single frame. Throws
-// ssao_io::UsageError for a range that runs backwards, negative frame numbers, an empty subset
+// ssao_tools::UsageError for a range that runs backwards, negative frame numbers, an empty subset
 // or an option povray-ssao cannot use (a subset given as a fraction).
 std::vector<AnimationFrame> animation_frames(const ClockOptions& clock);
 

@@ -16,13 +16,14 @@
 #include <vector>
 
 #include "animation.h"
-#include "io/image_io.h"
-#include "io/job.h"
-#include "io/param_flags.h"
 #include "passes.h"
 #include "pov_camera.h"
 #include "povray_run.h"
 #include "sdl.h"
+#include "ssao/ssao.hpp"
+#include "tools/files.h"
+#include "tools/image_io.h"
+#include "tools/param_flags.h"
 
 #ifndef POVRAY_SSAO_SOURCE_INCLUDES
 #define POVRAY_SSAO_SOURCE_INCLUDES ""
@@ -101,29 +102,8 @@ class Reporter {
 
 std::string in_quotes(const std::string& path) { return "'" + path + "'"; }
 
-// Fails before any work when an output cannot be created.
-void check_output_folder(const std::string& path) {
-  fs::path folder = fs::path(path).parent_path();
-  if (folder.empty()) folder = ".";
-  std::error_code ec;
-  if (!fs::is_directory(folder, ec)) {
-    throw ssao_io::Error("cannot write " + in_quotes(path) + ": no folder " +
-                         in_quotes(folder.string()));
-  }
-  if (::access(folder.c_str(), W_OK) != 0) {
-    throw ssao_io::Error("cannot write " + in_quotes(path) + ": folder " +
-                         in_quotes(folder.string()) + " is not writable");
-  }
-  if (fs::is_directory(path, ec)) {
-    throw ssao_io::Error("cannot write " + in_quotes(path) + ": it is a directory");
-  }
-}
-
-bool same_file(const std::string& a, const std::string& b) {
-  std::error_code ec;
-  if (fs::exists(a, ec) && fs::exists(b, ec)) return fs::equivalent(a, b, ec);
-  return fs::weakly_canonical(a, ec) == fs::weakly_canonical(b, ec);
-}
+using ssao_tools::check_output_folder;
+using ssao_tools::same_file;
 
 // The folder of the shipped includes: next to the binary (<bin>/../share/povray-ssao), else
 // the source tree's povray_bridge/pov.
@@ -142,7 +122,7 @@ std::string include_folder() {
     }
     tried += (tried.empty() ? "" : ", ") + in_quotes(candidate.string());
   }
-  throw ssao_io::Error(
+  throw ssao_tools::Error(
       "cannot find povray-ssao's include files ssao_depth_pre.inc, "
       "ssao_depth_post.inc and ssao_ambient_post.inc (looked in " +
       tried + ")");
@@ -188,14 +168,14 @@ struct AoInputs {
 
 // Copies the channels R, G, B (and A) of `image` into RGBA; a grey image (Y or one channel)
 // gives R = G = B.
-void take_beauty(const ssao_io::Image& image, const std::string& path, AoInputs& in) {
+void take_beauty(const ssao_tools::Image& image, const std::string& path, AoInputs& in) {
   int rgb[3] = {image.find_channel("R"), image.find_channel("G"), image.find_channel("B")};
   if (rgb[0] < 0 || rgb[1] < 0 || rgb[2] < 0) {
     int grey = image.find_channel("Y");
     if (grey < 0 && image.channels() <= 2) grey = 0;
     if (grey < 0) {
-      throw ssao_io::Error(in_quotes(path) + " has no R, G, B channels; its channels are: " +
-                           ssao_io::join_names(image.channel_names));
+      throw ssao_tools::Error(in_quotes(path) + " has no R, G, B channels; its channels are: " +
+                              ssao_tools::join_names(image.channel_names));
     }
     rgb[0] = rgb[1] = rgb[2] = grey;
   }
@@ -257,8 +237,8 @@ void write_outputs(const Options& o, const AoInputs& in, const std::vector<float
     full[p * 7 + 6] = in.radial[p];
   }
   auto write_main = [&]() {
-    if (!ssao_io::is_preview_path(o.output)) {
-      ssao_io::write_exr(o.output, in.width, in.height, full_channel_names(), full);
+    if (!ssao_tools::is_preview_path(o.output)) {
+      ssao_tools::write_exr(o.output, in.width, in.height, full_channel_names(), full);
       return;
     }
     const size_t channels = in.beauty_has_alpha ? 4 : 3;
@@ -268,13 +248,13 @@ void write_outputs(const Options& o, const AoInputs& in, const std::vector<float
     }
     std::vector<std::string> names = {"R", "G", "B", "A"};
     names.resize(channels);
-    ssao_io::write_preview(o.output, in.width, in.height, names, preview);
+    ssao_tools::write_preview(o.output, in.width, in.height, names, preview);
   };
   if (o.exr.empty()) {
     write_main();
     return;
   }
-  ssao_io::write_exr(o.exr, in.width, in.height, full_channel_names(), full);
+  ssao_tools::write_exr(o.exr, in.width, in.height, full_channel_names(), full);
   try {
     write_main();
   } catch (...) {
@@ -284,15 +264,13 @@ void write_outputs(const Options& o, const AoInputs& in, const std::vector<float
   }
 }
 
-int progress_callback(void*, double) { return InterruptGuard::interrupted() ? 0 : 1; }
-
 // Runs libssao and writes the outputs; returns the seconds spent in ssao_job_run.
 double compute_and_write(const Options& o, AoInputs& in, const Reporter& report) {
-  ssao_io::Job job;
+  ssao::api::Job job;
   in.camera.apply_to_job(job, in.width, in.height);
   job.set("depth_kind", in.planar_input ? "planar" : "radial");
   if (!in.normals.empty()) job.set("normal_space", "camera");
-  ssao_io::apply_params(job, o.params);
+  ssao_tools::apply_params(job, o.params);
 
   const size_t count = static_cast<size_t>(in.width) * static_cast<size_t>(in.height);
   std::vector<float> ao(count, 1.0f);
@@ -321,7 +299,7 @@ double compute_and_write(const Options& o, AoInputs& in, const Reporter& report)
   if (!in.ambient.empty()) job.set_image("ambient", in.ambient.data(), in.width, in.height, 4);
   job.set_image("composite", composite.data(), in.width, in.height, 4);
   job.set_image("ao", ao.data(), in.width, in.height, 1);
-  job.set_progress(&progress_callback, nullptr);
+  job.set_progress(&InterruptGuard::cancel_if_interrupted, nullptr);
   if (!o.param("radius")) {
     double radius = 0.0;
     if (ssao_job_auto_radius(job.get(), &radius) == SSAO_OK) {
@@ -339,9 +317,9 @@ double compute_and_write(const Options& o, AoInputs& in, const Reporter& report)
   const double seconds = seconds_since(start);
   if (status == SSAO_ERROR_CANCELLED || InterruptGuard::interrupted()) {
     report.end("interrupted");
-    throw ssao_io::Error("interrupted; nothing written");
+    throw ssao_tools::Error("interrupted; nothing written");
   }
-  ssao_io::check_status(status, "SSAO failed");
+  ssao::api::check_status(status, "SSAO failed");
   if (gamma) {
     for (size_t p = 0; p < count; ++p) {
       for (size_t c = 0; c < 3; ++c) {
@@ -436,7 +414,7 @@ struct Povray {
       message += ". Its last messages:\n" + povray_error_lines(render.log);
       if (!keep) message += "(--keep DIR keeps the wrappers and the full logs)";
       while (!message.empty() && message.back() == '\n') message.pop_back();
-      throw ssao_io::Error(message);
+      throw ssao_tools::Error(message);
     }
     return result.seconds;
   }
@@ -489,7 +467,7 @@ void print_camera(const CameraReading& reading, int width, int height, int band)
     std::printf("every pass is rendered with (after the scene):\n%s",
                 reading.camera.to_sdl().c_str());
   }
-  ssao_io::Job job;
+  ssao::api::Job job;
   reading.camera.apply_to_job(job, width, height);
   if (reading.camera.orthographic) {
     std::printf("libssao (%dx%d): camera_type ORTHO, ortho_scale %.9g", width, height,
@@ -532,7 +510,7 @@ int guard_band(const Options& o, int width, int height) {
   if (!fits(band)) {
     const long long data_width = static_cast<long long>(width) + 2LL * band;
     const long long data_height = static_cast<long long>(height) + 2LL * band;
-    throw ssao_io::Error(
+    throw ssao_tools::Error(
         "--overscan " + std::to_string(band) + ": the data passes would be " +
         std::to_string(data_width) + "x" + std::to_string(data_height) +
         ", over povray-ssao's limit of 65536 pixels a side and 67108864 pixels (8192 x 8192); "
@@ -553,7 +531,7 @@ void render_image(const Options& o, const RenderSetup& setup, const AnimationFra
   if (!o.keep.empty()) {
     fs::create_directories(o.keep, ec);
     if (!fs::is_directory(o.keep, ec)) {
-      throw ssao_io::Error("--keep: cannot create the folder " + in_quotes(o.keep));
+      throw ssao_tools::Error("--keep: cannot create the folder " + in_quotes(o.keep));
     }
   }
   ScanSettings settings = setup.settings;
@@ -620,7 +598,7 @@ void render_image(const Options& o, const RenderSetup& setup, const AnimationFra
           "povray-ssao cannot read the scene's ambient_light (" + scan.ambient_light_problem + ")";
     }
     if (!why_not.empty()) {
-      if (o.apply_to == "ambient") throw ssao_io::Error("--apply-to ambient: " + why_not);
+      if (o.apply_to == "ambient") throw ssao_tools::Error("--apply-to ambient: " + why_not);
       report.progress("AO darkens the whole image: %s", why_not.c_str());
       ambient_pass = false;
     }
@@ -681,7 +659,7 @@ void render_image(const Options& o, const RenderSetup& setup, const AnimationFra
     for (const std::string& d : fog_declares(prepass_distances())) extra.push_back(d);
     if (scan.uses_radiosity) extra.push_back("Declare=SSAODepthCheapRadiosity=1");
     prepass_seconds = povray.render("depth-range pre-pass", "prepass", "depth.pov", pw, ph, extra);
-    const ssao_io::Image image = ssao_io::read_image(povray.output("prepass"));
+    const ssao_tools::Image image = ssao_tools::read_image(povray.output("prepass"));
     const DepthStats stats =
         depth_stats(decode_fog(image, prepass_distances(), povray.output("prepass")));
     distances = choose_distances(stats);
@@ -718,18 +696,18 @@ void render_image(const Options& o, const RenderSetup& setup, const AnimationFra
                                           : "the beauty and the depth pass",
                   width, height);
   // The image file module (OpenImageIO) loads while POV-Ray renders.
-  ssao_io::preload_image_io();
+  ssao_tools::preload_image_io();
 
   // The depth pass.
   double depth_seconds = 0.0;
   std::vector<float> depth;
   for (int attempt = 0;; ++attempt) {
     depth_seconds += povray.finish(depth_render);
-    const ssao_io::Image image = ssao_io::read_image(depth_render.output);
+    const ssao_tools::Image image = ssao_tools::read_image(depth_render.output);
     if (image.width != data_width || image.height != data_height) {
-      throw ssao_io::Error("POV-Ray rendered the depth pass at " + std::to_string(image.width) +
-                           "x" + std::to_string(image.height) + " instead of " +
-                           std::to_string(data_width) + "x" + std::to_string(data_height));
+      throw ssao_tools::Error("POV-Ray rendered the depth pass at " + std::to_string(image.width) +
+                              "x" + std::to_string(image.height) + " instead of " +
+                              std::to_string(data_width) + "x" + std::to_string(data_height));
     }
     std::vector<float> precision;
     depth = decode_fog(image, distances, depth_render.output, &precision);
@@ -758,7 +736,7 @@ void render_image(const Options& o, const RenderSetup& setup, const AnimationFra
       if (e.median > kUnusableDepthError) {
         char buffer[32];
         std::snprintf(buffer, sizeof buffer, "%.2g", e.median);
-        throw ssao_io::Error(
+        throw ssao_tools::Error(
             std::string("the depth pass measured no usable distances (median estimated error ") +
             buffer +
             " of the depth). POV-Ray renders no fog for a camera inside a non-hollow object, "
@@ -788,7 +766,7 @@ void render_image(const Options& o, const RenderSetup& setup, const AnimationFra
       pixels[p * 2] = in.planar[p];
       pixels[p * 2 + 1] = in.radial[p];
     }
-    ssao_io::write_exr(o.output, width, height, {"Z", "Radial"}, pixels);
+    ssao_tools::write_exr(o.output, width, height, {"Z", "Radial"}, pixels);
     if (prepass_seconds > 0.0) {
       report.progress("wrote %s (Z, Radial) in %.2f s: pre-pass %.2f s, depth %.2f s",
                       o.output.c_str(), seconds_since(start), prepass_seconds, depth_seconds);
@@ -802,12 +780,12 @@ void render_image(const Options& o, const RenderSetup& setup, const AnimationFra
   // The beauty.
   const double beauty_seconds = povray.finish(beauty_render);
   {
-    const ssao_io::Image beauty = ssao_io::read_image(beauty_render.output);
+    const ssao_tools::Image beauty = ssao_tools::read_image(beauty_render.output);
     if (beauty.width != width || beauty.height != height) {
-      throw ssao_io::Error("POV-Ray rendered the beauty at " + std::to_string(beauty.width) + "x" +
-                           std::to_string(beauty.height) + " instead of " + std::to_string(width) +
-                           "x" + std::to_string(height) +
-                           " (partial render options in the INI file?)");
+      throw ssao_tools::Error("POV-Ray rendered the beauty at " + std::to_string(beauty.width) +
+                              "x" + std::to_string(beauty.height) + " instead of " +
+                              std::to_string(width) + "x" + std::to_string(height) +
+                              " (partial render options in the INI file?)");
     }
     take_beauty(beauty, beauty_render.output, in);
   }
@@ -818,11 +796,12 @@ void render_image(const Options& o, const RenderSetup& setup, const AnimationFra
   double ambient_seconds = 0.0;
   if (ambient_pass) {
     ambient_seconds = povray.finish(ambient_render);
-    const ssao_io::Image image = ssao_io::read_image(ambient_render.output);
+    const ssao_tools::Image image = ssao_tools::read_image(ambient_render.output);
     if (image.width != width || image.height != height) {
-      throw ssao_io::Error("POV-Ray rendered the ambient pass at " + std::to_string(image.width) +
-                           "x" + std::to_string(image.height) + " instead of " +
-                           std::to_string(width) + "x" + std::to_string(height));
+      throw ssao_tools::Error("POV-Ray rendered the ambient pass at " +
+                              std::to_string(image.width) + "x" + std::to_string(image.height) +
+                              " instead of " + std::to_string(width) + "x" +
+                              std::to_string(height));
     }
     const V3 light = scan.ambient_light.value_or(V3{1.0, 1.0, 1.0});
     size_t overflowed = 0;
@@ -870,13 +849,13 @@ void render_image(const Options& o, const RenderSetup& setup, const AnimationFra
   if (normal_render.process) {
     normal_seconds = povray.finish(normal_render);
     report.progress("  normal pass %.2f s", normal_seconds);
-    const ssao_io::Image image = ssao_io::read_image(normal_render.output);
+    const ssao_tools::Image image = ssao_tools::read_image(normal_render.output);
     double unit_fraction = 0.0;
     // decode_normals reads the depth of every pixel of the image: only a pass of its size.
     if (image.width != data_width || image.height != data_height) {
-      throw ssao_io::Error("POV-Ray rendered the normal pass at " + std::to_string(image.width) +
-                           "x" + std::to_string(image.height) + " instead of " +
-                           std::to_string(data_width) + "x" + std::to_string(data_height));
+      throw ssao_tools::Error("POV-Ray rendered the normal pass at " + std::to_string(image.width) +
+                              "x" + std::to_string(image.height) + " instead of " +
+                              std::to_string(data_width) + "x" + std::to_string(data_height));
     }
     std::vector<float> normals =
         decode_normals(image, in.depth_input, normal_render.output, unit_fraction);
@@ -932,8 +911,8 @@ void render_animation(const Options& o, const RenderSetup& setup,
       render_image(frame_options, setup, &frame, report);
       ++written;
     } catch (const UsageError&) {
-      throw;  // a command-line mistake is every frame's
-    } catch (const ssao_io::Error& e) {
+      throw;                                 // a command-line mistake is every frame's
+    } catch (const std::runtime_error& e) {  // ours or the library's (ssao::api::Error)
       if (InterruptGuard::interrupted()) throw;
       std::fprintf(stderr, "povray-ssao: frame %ld: error: %s\n", frame.number, e.what());
       std::fflush(stderr);
@@ -956,8 +935,8 @@ void render_animation(const Options& o, const RenderSetup& setup,
   report.progress("%zu of %zu frames written in %.1f s (%.1f frames per minute)", written,
                   frames.size(), wall, wall > 0.0 ? 60.0 * double(written) / wall : 0.0);
   if (!failed.empty()) {
-    throw ssao_io::Error(std::to_string(failed.size()) + " of " + std::to_string(frames.size()) +
-                         " frames failed: " + list);
+    throw ssao_tools::Error(std::to_string(failed.size()) + " of " + std::to_string(frames.size()) +
+                            " frames failed: " + list);
   }
 }
 }  // namespace
@@ -968,18 +947,18 @@ void run_render(const Options& o) {
 
   // Everything that can be checked before POV-Ray runs.
   std::error_code ec;
-  if (!fs::exists(o.scene, ec)) throw ssao_io::Error("no scene file " + in_quotes(o.scene));
+  if (!fs::exists(o.scene, ec)) throw ssao_tools::Error("no scene file " + in_quotes(o.scene));
   if (!fs::is_regular_file(o.scene, ec)) {
-    throw ssao_io::Error("the scene " + in_quotes(o.scene) + " is not a file");
+    throw ssao_tools::Error("the scene " + in_quotes(o.scene) + " is not a file");
   }
   if (::access(o.scene.c_str(), R_OK) != 0) {
-    throw ssao_io::Error("cannot read the scene file " + in_quotes(o.scene));
+    throw ssao_tools::Error("cannot read the scene file " + in_quotes(o.scene));
   }
   const fs::path scene_path = fs::absolute(o.scene).lexically_normal();
   const std::string scene_folder = scene_path.parent_path().string();
   const std::string scene_name = scene_path.filename().string();
   if (scene_name.find('"') != std::string::npos) {
-    throw ssao_io::Error(
+    throw ssao_tools::Error(
         "the scene's file name contains '\"', which POV-Ray's #include cannot "
         "take");
   }
@@ -991,12 +970,12 @@ void run_render(const Options& o) {
     }
   }
   if (!o.ini.empty() && !fs::is_regular_file(o.ini, ec)) {
-    throw ssao_io::Error("no INI file " + in_quotes(o.ini));
+    throw ssao_tools::Error("no INI file " + in_quotes(o.ini));
   }
   if (!o.keep.empty()) {
     fs::create_directories(o.keep, ec);
     if (!fs::is_directory(o.keep, ec)) {
-      throw ssao_io::Error("--keep: cannot create the folder " + in_quotes(o.keep));
+      throw ssao_tools::Error("--keep: cannot create the folder " + in_quotes(o.keep));
     }
   }
 
@@ -1009,9 +988,9 @@ void run_render(const Options& o) {
   }
   default_size(scene_folder, width, height);
   if (width > kMaxSide || height > kMaxSide || double(width) * double(height) > kMaxPixels) {
-    throw ssao_io::Error("the image size " + std::to_string(width) + "x" + std::to_string(height) +
-                         " is over povray-ssao's limit of " +
-                         "67108864 pixels (8192 x 8192, about 4 GB of passes)");
+    throw ssao_tools::Error("the image size " + std::to_string(width) + "x" +
+                            std::to_string(height) + " is over povray-ssao's limit of " +
+                            "67108864 pixels (8192 x 8192, about 4 GB of passes)");
   }
   guard_band(o, width, height);  // a band too large is every frame's mistake: refuse it now
 
@@ -1089,18 +1068,18 @@ void run_post_process(const Options& o) {
     }
   }
 
-  ssao_io::Image beauty = ssao_io::read_image(o.beauty);
+  ssao_tools::Image beauty = ssao_tools::read_image(o.beauty);
   const std::string encoding = beauty.color_space;
-  if (ssao_io::linearize(beauty)) {
+  if (ssao_tools::linearize(beauty)) {
     report.progress("beauty %s is %s-encoded: linearised before the multiplication",
                     o.beauty.c_str(), encoding.c_str());
   }
-  ssao_io::Image depth_image = ssao_io::read_image(o.depth);
+  ssao_tools::Image depth_image = ssao_tools::read_image(o.depth);
   if (beauty.width != depth_image.width || beauty.height != depth_image.height) {
-    throw ssao_io::Error("the beauty is " + std::to_string(beauty.width) + "x" +
-                         std::to_string(beauty.height) + " but the depth is " +
-                         std::to_string(depth_image.width) + "x" +
-                         std::to_string(depth_image.height));
+    throw ssao_tools::Error("the beauty is " + std::to_string(beauty.width) + "x" +
+                            std::to_string(beauty.height) + " but the depth is " +
+                            std::to_string(depth_image.width) + "x" +
+                            std::to_string(depth_image.height));
   }
   std::string channel = o.depth_channel;
   if (channel.empty()) {
@@ -1114,11 +1093,11 @@ void run_post_process(const Options& o) {
     if (channel.empty()) {
       throw UsageError("cannot tell which channel of " + in_quotes(o.depth) +
                        " holds the depth; name it with --depth-channel (channels: " +
-                       ssao_io::join_names(depth_image.channel_names) + ")");
+                       ssao_tools::join_names(depth_image.channel_names) + ")");
     }
   }
-  const int index = ssao_io::require_channel(depth_image, channel, o.depth);
-  const ssao_io::ParamSetting* kind = o.param("depth_kind");
+  const int index = ssao_tools::require_channel(depth_image, channel, o.depth);
+  const ssao_tools::ParamSetting* kind = o.param("depth_kind");
   const bool planar = kind ? kind->string_value == "planar" : channel == "Z";
 
   AoInputs in;
@@ -1130,7 +1109,7 @@ void run_post_process(const Options& o) {
                             : static_cast<double>(in.width) / static_cast<double>(in.height);
   in.camera = make_camera(o.camera.orthographic, o.camera.angle.value_or(0.0),
                           o.camera_width.value_or(0.0), aspect);
-  std::vector<float> depth = ssao_io::extract_channels(depth_image, {index});
+  std::vector<float> depth = ssao_tools::extract_channels(depth_image, {index});
   for (float& d : depth) {
     d = static_cast<float>(d * o.depth_scale);
     if (!(std::isfinite(d) && d > 0.0f)) d = kInfinity;

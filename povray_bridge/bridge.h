@@ -7,7 +7,7 @@
 
 namespace povray_ssao {
 
-// Both throw UsageError for command-line mistakes found late and ssao_io::Error for any other
+// Both throw UsageError for command-line mistakes found late and ssao_tools::Error for any other
 // failure; in both cases no output file is left behind.
 void run_render(const Options& options);
 void run_post_process(const Options& options);

@@ -5,18 +5,18 @@
 #include <cctype>
 #include <cmath>
 
-#include "io/camera_json.h"
-#include "io/image_io.h"
+#include "tools/camera_json.h"
+#include "tools/image_io.h"
 
 namespace povray_ssao {
 namespace {
 
-using ssao_io::help_entry;
-using ssao_io::parse_float;
-using ssao_io::parse_int;
+using ssao_tools::help_entry;
+using ssao_tools::parse_float;
+using ssao_tools::parse_int;
 
 V3 parse_vector(const std::string& flag, const std::string& text) {
-  const std::vector<std::string> parts = ssao_io::split(text, ',');
+  const std::vector<std::string> parts = ssao_tools::split(text, ',');
   if (parts.size() != 3) {
     throw UsageError(flag + " expects X,Y,Z (three comma-separated numbers), got '" + text + "'");
   }
@@ -44,7 +44,7 @@ std::string upper(std::string text) {
 // Front-end options (not library parameters): the table drives parsing, --help and
 // suggestions.
 enum Group { kRender, kCamera, kPost, kOther };
-using FrontOption = ssao_io::FrontOption<Options, Group>;
+using FrontOption = ssao_tools::FrontOption<Options, Group>;
 
 const std::vector<FrontOption>& front_options() {
   static const std::vector<FrontOption> options = {
@@ -103,7 +103,7 @@ const std::vector<FrontOption>& front_options() {
        "use these fog distances for the depth pass (scene units; D3 adds a third fog on B for "
        "far depths) instead of the camera's look_at distance or a pre-pass",
        [](Options& o, const std::string& f, const std::string& v) {
-         const std::vector<std::string> parts = ssao_io::split(v, ',');
+         const std::vector<std::string> parts = ssao_tools::split(v, ',');
          if (parts.size() != 2 && parts.size() != 3) {
            throw UsageError(f + " expects D1,D2 or D1,D2,D3, got '" + v + "'");
          }
@@ -193,7 +193,7 @@ const std::vector<FrontOption>& front_options() {
 
 // Library parameters povray-ssao sets itself from the POV-Ray camera and the passes.
 bool set_by_bridge(const std::string& name, bool post_process) {
-  if (ssao_io::is_camera_param(name)) return true;
+  if (ssao_tools::is_camera_param(name)) return true;
   if (name == "normal_space") return true;
   return name == "depth_kind" && !post_process;
 }
@@ -257,7 +257,7 @@ bool has_extension(const std::string& path, const std::string& extension) {
 
 void check_output_name(const std::string& flag, const std::string& path, bool allow_preview) {
   if (has_extension(path, ".exr")) return;
-  if (allow_preview && ssao_io::is_preview_path(path)) return;
+  if (allow_preview && ssao_tools::is_preview_path(path)) return;
   throw UsageError(flag + " " + path +
                    (allow_preview ? ": use .png, .jpg or .tif (8-bit sRGB) or .exr (float)"
                                   : ": must be an OpenEXR file (.exr)"));
@@ -270,7 +270,7 @@ void validate(const Options& o) {
     if (o.exr == o.output) throw UsageError("-o and --exr name the same file");
   }
   const bool post = o.post_process();
-  for (const ssao_io::ParamSetting& p : o.params) {
+  for (const ssao_tools::ParamSetting& p : o.params) {
     if (set_by_bridge(p.name, post)) {
       throw UsageError(p.flag + ": povray-ssao sets " + p.name +
                        " itself from the POV-Ray camera and passes" +
@@ -355,9 +355,9 @@ int default_guard_band(int width, int height) {
   return static_cast<int>((static_cast<long long>(larger) + 9) / 10);
 }
 
-const ssao_io::ParamSetting* Options::param(const std::string& name) const {
-  const ssao_io::ParamSetting* found = nullptr;
-  for (const ssao_io::ParamSetting& p : params) {
+const ssao_tools::ParamSetting* Options::param(const std::string& name) const {
+  const ssao_tools::ParamSetting* found = nullptr;
+  for (const ssao_tools::ParamSetting& p : params) {
     if (p.name == name) found = &p;
   }
   return found;
@@ -365,7 +365,7 @@ const ssao_io::ParamSetting* Options::param(const std::string& name) const {
 
 Options parse_args(int argc, const char* const* argv, const std::vector<ssao_param_desc>& table) {
   Options out;
-  if (ssao_io::scan_help_and_version(argc, argv, out)) return out;
+  if (ssao_tools::scan_help_and_version(argc, argv, out)) return out;
   bool only_positionals = false;
   for (int i = 1; i < argc; ++i) {
     const std::string arg = argv[i];
@@ -388,7 +388,7 @@ Options parse_args(int argc, const char* const* argv, const std::vector<ssao_par
       out.scene = arg;
       continue;
     }
-    ssao_io::parse_option(argc, argv, i, front_options(), table, out);
+    ssao_tools::parse_option(argc, argv, i, front_options(), table, out);
   }
   validate(out);
   return out;
@@ -448,7 +448,7 @@ std::string usage_text(const std::vector<ssao_param_desc>& table) {
   text +=
       "\nAO parameters (libssao's parameter table; --NAME_WITH_UNDERSCORES is written with\n"
       "dashes; the camera parameters, depth_kind and normal_space are set by povray-ssao):\n";
-  text += ssao_io::param_help(
+  text += ssao_tools::param_help(
       table, [](const ssao_param_desc& desc) { return !set_by_bridge(desc.name, false); });
   text +=
       "\n"

@@ -8,13 +8,13 @@
 #include <string>
 #include <vector>
 
-#include "io/param_flags.h"
 #include "passes.h"
 #include "pov_camera.h"
+#include "tools/param_flags.h"
 
 namespace povray_ssao {
 
-using ssao_io::UsageError;
+using ssao_tools::UsageError;
 
 struct Options {
   bool help = false;
@@ -48,11 +48,11 @@ struct Options {
   // Both.
   std::string output;
   std::string exr;
-  std::vector<ssao_io::ParamSetting> params;  // in command-line order
+  std::vector<ssao_tools::ParamSetting> params;  // in command-line order
 
   bool post_process() const { return !beauty.empty() || !depth.empty(); }
   // The value given for a library parameter, or nullptr.
-  const ssao_io::ParamSetting* param(const std::string& name) const;
+  const ssao_tools::ParamSetting* param(const std::string& name) const;
 };
 
 // The guard band povray-ssao renders around a W x H frame without --overscan (docs/povray.md,

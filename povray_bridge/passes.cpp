@@ -14,7 +14,7 @@ void write_text(const std::string& path, const std::string& text) {
   std::ofstream file(path, std::ios::binary);
   file << text;
   file.close();
-  if (!file) throw ssao_io::Error("cannot write '" + path + "'");
+  if (!file) throw ssao_tools::Error("cannot write '" + path + "'");
 }
 
 std::string number(double value) {
@@ -75,11 +75,11 @@ FogDistances prepass_distances() {
   return d;
 }
 
-std::vector<float> decode_fog(const ssao_io::Image& image, const FogDistances& distances,
+std::vector<float> decode_fog(const ssao_tools::Image& image, const FogDistances& distances,
                               const std::string& path, std::vector<float>* precision) {
-  const int r = ssao_io::require_channel(image, "R", path);
-  const int g = ssao_io::require_channel(image, "G", path);
-  const int b = ssao_io::require_channel(image, "B", path);
+  const int r = ssao_tools::require_channel(image, "R", path);
+  const int g = ssao_tools::require_channel(image, "G", path);
+  const int b = ssao_tools::require_channel(image, "B", path);
   const size_t stride = static_cast<size_t>(image.channels());
   const double k = kFogColour;
   const bool three = distances.d3 > 0.0;
@@ -161,11 +161,11 @@ FogDistances choose_distances(const DepthStats& stats) {
   return out;
 }
 
-std::vector<float> decode_ambient(const ssao_io::Image& image, V3 ambient_light,
+std::vector<float> decode_ambient(const ssao_tools::Image& image, V3 ambient_light,
                                   const std::string& path, size_t& overflowed) {
-  const int channel[3] = {ssao_io::require_channel(image, "R", path),
-                          ssao_io::require_channel(image, "G", path),
-                          ssao_io::require_channel(image, "B", path)};
+  const int channel[3] = {ssao_tools::require_channel(image, "R", path),
+                          ssao_tools::require_channel(image, "G", path),
+                          ssao_tools::require_channel(image, "B", path)};
   const double light[3] = {ambient_light.x, ambient_light.y, ambient_light.z};
   const size_t stride = static_cast<size_t>(image.channels());
   std::vector<float> ambient(image.pixel_count() * 3, 0.0f);
@@ -189,11 +189,11 @@ std::vector<float> decode_ambient(const ssao_io::Image& image, V3 ambient_light,
   return ambient;
 }
 
-std::vector<float> decode_normals(const ssao_io::Image& image, const std::vector<float>& depth,
+std::vector<float> decode_normals(const ssao_tools::Image& image, const std::vector<float>& depth,
                                   const std::string& path, double& unit_fraction) {
-  const int channel[3] = {ssao_io::require_channel(image, "R", path),
-                          ssao_io::require_channel(image, "G", path),
-                          ssao_io::require_channel(image, "B", path)};
+  const int channel[3] = {ssao_tools::require_channel(image, "R", path),
+                          ssao_tools::require_channel(image, "G", path),
+                          ssao_tools::require_channel(image, "B", path)};
   const size_t stride = static_cast<size_t>(image.channels());
   std::vector<float> normals(image.pixel_count() * 3, 0.0f);
   size_t geometry = 0, unit = 0;

@@ -16,8 +16,8 @@
 #include <string>
 #include <vector>
 
-#include "io/image_io.h"
 #include "pov_camera.h"
+#include "tools/image_io.h"
 
 namespace povray_ssao {
 
@@ -57,7 +57,7 @@ FogDistances prepass_distances();
 // `precision`, if given, receives the estimated relative error of each pixel (half-float
 // rounding of the channel used, plus the leaked scene colour estimated from B when B carries no
 // fog; 0 on background).
-std::vector<float> decode_fog(const ssao_io::Image& image, const FogDistances& distances,
+std::vector<float> decode_fog(const ssao_tools::Image& image, const FogDistances& distances,
                               const std::string& path, std::vector<float>* precision = nullptr);
 
 // Statistics of the finite, positive values.
@@ -76,7 +76,7 @@ FogDistances choose_distances(const DepthStats& stats);
 // The ambient term of each pixel (R, G, B; linear, the scene's working space) from the ambient
 // pass: value / kAmbientScale x `ambient_light`. Pixels that overflowed half-float (a finish
 // ambient x pigment above 6.5) or are not finite get 0 and are counted in `overflowed`.
-std::vector<float> decode_ambient(const ssao_io::Image& image, V3 ambient_light,
+std::vector<float> decode_ambient(const ssao_tools::Image& image, V3 ambient_light,
                                   const std::string& path, size_t& overflowed);
 
 // Decodes the opt-in normal pass (ssao_passes.inc, SSAOPass=1): per channel
@@ -84,7 +84,7 @@ std::vector<float> decode_ambient(const ssao_io::Image& image, V3 ambient_light,
 // libssao's camera space (x, y, -z), 3 floats per pixel; 0 where `depth` is background.
 // Sets `unit_fraction` to the fraction of geometry pixels whose decoded normal has unit length
 // within 2% (a check of the encoding).
-std::vector<float> decode_normals(const ssao_io::Image& image, const std::vector<float>& depth,
+std::vector<float> decode_normals(const ssao_tools::Image& image, const std::vector<float>& depth,
                                   const std::string& path, double& unit_fraction);
 
 }  // namespace povray_ssao

@@ -690,15 +690,15 @@ std::string ResolvedCamera::summary() const {
   return buffer;
 }
 
-void ResolvedCamera::apply_to_job(ssao_io::Job& job, int width, int height) const {
+void ResolvedCamera::apply_to_job(ssao::api::Job& job, int width, int height) const {
   try {
     set_job_camera(job, width, height);
-  } catch (const ssao_io::CoreError& e) {
-    throw ssao_io::Error("libssao cannot model this camera (" + summary() + "): " + e.what());
+  } catch (const ssao::api::Error& e) {
+    throw ssao_tools::Error("libssao cannot model this camera (" + summary() + "): " + e.what());
   }
 }
 
-void ResolvedCamera::set_job_camera(ssao_io::Job& job, int width, int height) const {
+void ResolvedCamera::set_job_camera(ssao::api::Job& job, int width, int height) const {
   const double r = length(right), u = length(up), d = length(direction);
   job.set("camera_type", orthographic ? "ORTHO" : "PERSP");
   job.set("sensor_fit", "HORIZONTAL");
@@ -786,11 +786,11 @@ CameraReading read_camera(const SceneScan& scan, const CameraOverrides& override
     }
     problem += " (include files not found, so not read: " + names + ")";
   }
-  throw ssao_io::Error(problem +
-                       ".\nGive the camera on the command line instead, e.g. --camera-location "
-                       "X,Y,Z --camera-look-at X,Y,Z --camera-angle DEG (also --camera-right, "
-                       "--camera-up, --camera-sky, --camera-direction, --camera-orthographic); "
-                       "flags replace the values read from the scene");
+  throw ssao_tools::Error(problem +
+                          ".\nGive the camera on the command line instead, e.g. --camera-location "
+                          "X,Y,Z --camera-look-at X,Y,Z --camera-angle DEG (also --camera-right, "
+                          "--camera-up, --camera-sky, --camera-direction, --camera-orthographic); "
+                          "flags replace the values read from the scene");
 }
 
 ResolvedCamera make_camera(bool orthographic, double angle, double ortho_width, double aspect) {

@@ -15,8 +15,8 @@
 #include <string>
 #include <vector>
 
-#include "io/job.h"
 #include "sdl.h"
+#include "ssao/ssao.hpp"
 
 namespace povray_ssao {
 
@@ -56,7 +56,7 @@ struct ResolvedCamera {
 
   // Sets camera_type, lens or ortho_scale, sensor_width 36, sensor_fit HORIZONTAL and the
   // pixel aspect for a W x H image so that libssao's pixel <-> view mapping is POV-Ray's.
-  void apply_to_job(ssao_io::Job& job, int width, int height) const;
+  void apply_to_job(ssao::api::Job& job, int width, int height) const;
 
   // radial distance / planar depth of pixel (px, py): 1 for orthographic cameras.
   double radial_factor(int px, int py, int width, int height) const;
@@ -69,7 +69,7 @@ struct ResolvedCamera {
   ResolvedCamera widened(int width, int height, int band) const;
 
  private:
-  void set_job_camera(ssao_io::Job& job, int width, int height) const;
+  void set_job_camera(ssao::api::Job& job, int width, int height) const;
 };
 
 struct CameraReading {
@@ -79,7 +79,7 @@ struct CameraReading {
   std::vector<std::string> warnings;  // for the user
 };
 
-// The camera of a scan with the overrides applied on top. Throws ssao_io::Error with a message
+// The camera of a scan with the overrides applied on top. Throws ssao_tools::Error with a message
 // naming what could not be read and suggesting the --camera-* flags, when the camera is of
 // another type (fisheye, panoramic, ...), when an expression cannot be evaluated, or when no
 // camera block is found (unless the overrides are complete: location and look_at or direction).

@@ -26,9 +26,6 @@ namespace fs = std::filesystem;
 
 namespace {
 
-volatile std::sig_atomic_t g_interrupted = 0;
-extern "C" void on_interrupt(int) { g_interrupted = 1; }
-
 bool is_executable_file(const std::string& path) {
   std::error_code ec;
   return fs::is_regular_file(path, ec) && ::access(path.c_str(), X_OK) == 0;
@@ -59,7 +56,7 @@ int parse_positive(const std::string& text) {
 std::string find_executable(const std::string& name) {
   if (name.find('/') != std::string::npos) {
     if (is_executable_file(name)) return name;
-    throw ssao_io::Error("cannot run POV-Ray: '" + name + "' is not an executable file");
+    throw ssao_tools::Error("cannot run POV-Ray: '" + name + "' is not an executable file");
   }
   const char* path = std::getenv("PATH");
   std::stringstream folders(path ? path : "/usr/local/bin:/usr/bin:/bin");
@@ -69,9 +66,9 @@ std::string find_executable(const std::string& name) {
     const std::string candidate = folder + "/" + name;
     if (is_executable_file(candidate)) return candidate;
   }
-  throw ssao_io::Error("cannot run POV-Ray: no '" + name +
-                       "' in PATH (install POV-Ray 3.7, e.g. apt-get install povray, or give "
-                       "--povray PATH)");
+  throw ssao_tools::Error("cannot run POV-Ray: no '" + name +
+                          "' in PATH (install POV-Ray 3.7, e.g. apt-get install povray, or give "
+                          "--povray PATH)");
 }
 
 RunningProcess::RunningProcess(const std::string& executable, const std::vector<std::string>& args,
@@ -91,7 +88,8 @@ RunningProcess::RunningProcess(const std::string& executable, const std::vector<
   }
   const int log = ::open(log_path.c_str(), O_WRONLY | O_CREAT | O_APPEND | O_CLOEXEC, 0644);
   if (log < 0) {
-    throw ssao_io::Error("cannot create the log file '" + log_path + "': " + std::strerror(errno));
+    throw ssao_tools::Error("cannot create the log file '" + log_path +
+                            "': " + std::strerror(errno));
   }
   std::vector<std::string> argv_strings;
   argv_strings.push_back(executable);
@@ -105,7 +103,8 @@ RunningProcess::RunningProcess(const std::string& executable, const std::vector<
   child_ = ::fork();
   if (child_ < 0) {
     ::close(log);
-    throw ssao_io::Error(std::string("cannot start POV-Ray: fork failed: ") + std::strerror(errno));
+    throw ssao_tools::Error(std::string("cannot start POV-Ray: fork failed: ") +
+                            std::strerror(errno));
   }
   if (child_ == 0) {
     // The child: only async-signal-safe calls until exec.
@@ -145,16 +144,16 @@ RunningProcess::~RunningProcess() {
 
 RenderResult RunningProcess::wait_for_output() {
   if (inotify_ < 0) return wait();
-  if (child_ <= 0) throw ssao_io::Error("internal error: waited twice for a POV-Ray run");
+  if (child_ <= 0) throw ssao_tools::Error("internal error: waited twice for a POV-Ray run");
   alignas(inotify_event) char buffer[4096];
   while (true) {
     int status = 0;
     const pid_t done = ::waitpid(child_, &status, WNOHANG);
     if (done == child_) return reaped(status);
     if (done < 0 && errno != EINTR) {
-      throw ssao_io::Error(std::string("waiting for POV-Ray failed: ") + std::strerror(errno));
+      throw ssao_tools::Error(std::string("waiting for POV-Ray failed: ") + std::strerror(errno));
     }
-    if (g_interrupted) return wait();  // forwards the interruption and throws
+    if (InterruptGuard::interrupted()) return wait();  // forwards the interruption and throws
     pollfd events{inotify_, POLLIN, 0};
     if (::poll(&events, 1, 20) <= 0) continue;  // 20 ms: also the exit check's period
     const ssize_t length = ::read(inotify_, buffer, sizeof buffer);
@@ -174,16 +173,16 @@ RenderResult RunningProcess::wait_for_output() {
 }
 
 RenderResult RunningProcess::wait() {
-  if (child_ <= 0) throw ssao_io::Error("internal error: waited twice for a POV-Ray run");
+  if (child_ <= 0) throw ssao_tools::Error("internal error: waited twice for a POV-Ray run");
   int status = 0;
   bool forwarded = false;
   while (true) {
     const pid_t done = ::waitpid(child_, &status, 0);
     if (done == child_) break;
     if (done < 0 && errno != EINTR) {
-      throw ssao_io::Error(std::string("waiting for POV-Ray failed: ") + std::strerror(errno));
+      throw ssao_tools::Error(std::string("waiting for POV-Ray failed: ") + std::strerror(errno));
     }
-    if (g_interrupted && !forwarded) {
+    if (InterruptGuard::interrupted() && !forwarded) {
       ::kill(child_, SIGTERM);
       forwarded = true;
     }
@@ -200,15 +199,15 @@ RenderResult RunningProcess::reaped(int status) {
   } else if (WIFSIGNALED(status)) {
     result.exit_status = 128 + WTERMSIG(status);
   }
-  if (g_interrupted) throw ssao_io::Error("interrupted; nothing written");
+  if (InterruptGuard::interrupted()) throw ssao_tools::Error("interrupted; nothing written");
   if (result.exit_status == 127 || result.exit_status == 126) {
     std::ifstream file(log_path_);
     std::string text((std::istreambuf_iterator<char>(file)), std::istreambuf_iterator<char>());
     if (text.find("povray-ssao: cannot execute POV-Ray") != std::string::npos) {
-      throw ssao_io::Error("cannot execute '" + executable_ + "'");
+      throw ssao_tools::Error("cannot execute '" + executable_ + "'");
     }
     if (text.find("povray-ssao: cannot enter the scene's folder") != std::string::npos) {
-      throw ssao_io::Error("cannot enter the scene's folder '" + working_directory_ + "'");
+      throw ssao_tools::Error("cannot enter the scene's folder '" + working_directory_ + "'");
     }
   }
   return result;
@@ -254,7 +253,7 @@ namespace {
 // dropped, up to the first named section (POV-Ray reads only the unnamed one by default).
 std::vector<std::string> ini_lines(const std::string& path, bool required) {
   std::ifstream file(path);
-  if (!file && required) throw ssao_io::Error("cannot read the INI file '" + path + "'");
+  if (!file && required) throw ssao_tools::Error("cannot read the INI file '" + path + "'");
   std::vector<std::string> lines;
   std::string line;
   while (std::getline(file, line)) {
@@ -367,7 +366,7 @@ void default_size(const std::string& working_directory, int& width, int& height)
     int w = 0, h = 0;
     try {
       ini_size(ini, w, h);
-    } catch (const ssao_io::Error&) {
+    } catch (const ssao_tools::Error&) {
     }
     if (width == 0) width = w;
     if (height == 0) height = h;
@@ -382,8 +381,8 @@ ScratchFolder::ScratchFolder() {
   std::vector<char> buffer(pattern.begin(), pattern.end());
   buffer.push_back('\0');
   if (!::mkdtemp(buffer.data())) {
-    throw ssao_io::Error("cannot create a scratch folder '" + pattern +
-                         "': " + std::strerror(errno));
+    throw ssao_tools::Error("cannot create a scratch folder '" + pattern +
+                            "': " + std::strerror(errno));
   }
   path_ = buffer.data();
 }
@@ -392,21 +391,5 @@ ScratchFolder::~ScratchFolder() {
   std::error_code ec;
   fs::remove_all(path_, ec);
 }
-
-InterruptGuard::InterruptGuard() {
-  struct sigaction action {};
-  action.sa_handler = on_interrupt;
-  sigemptyset(&action.sa_mask);
-  action.sa_flags = 0;  // no SA_RESTART: waitpid returns EINTR so that we can forward it
-  ::sigaction(SIGINT, &action, nullptr);
-  ::sigaction(SIGTERM, &action, nullptr);
-}
-
-InterruptGuard::~InterruptGuard() {
-  std::signal(SIGINT, SIG_DFL);
-  std::signal(SIGTERM, SIG_DFL);
-}
-
-bool InterruptGuard::interrupted() { return g_interrupted != 0; }
 
 }  // namespace povray_ssao

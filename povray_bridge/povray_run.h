@@ -10,11 +10,12 @@
 #include <vector>
 
 #include "animation.h"
-#include "io/error.h"
+#include "tools/error.h"
+#include "tools/interrupt.h"
 
 namespace povray_ssao {
 
-// The full path of `name` (searched in PATH unless it contains a '/'). Throws ssao_io::Error
+// The full path of `name` (searched in PATH unless it contains a '/'). Throws ssao_tools::Error
 // if there is no such executable.
 std::string find_executable(const std::string& name);
 
@@ -26,8 +27,8 @@ struct RenderResult {
 };
 
 // `executable args...` running in `working_directory` with stdin from /dev/null and stdout and
-// stderr appended to `log_path`, started by the constructor (which throws ssao_io::Error if it
-// cannot start). wait() returns its result; it throws ssao_io::Error when the user interrupted
+// stderr appended to `log_path`, started by the constructor (which throws ssao_tools::Error if it
+// cannot start). wait() returns its result; it throws ssao_tools::Error when the user interrupted
 // it (SIGINT/SIGTERM, forwarded to POV-Ray) or it could not be executed. A process that is not
 // waited for is terminated (SIGTERM) and reaped by the destructor, so a failure elsewhere
 // leaves no render behind.
@@ -65,7 +66,7 @@ RenderResult run_process(const std::string& executable, const std::vector<std::s
 std::string povray_error_lines(const std::string& log_path, size_t max_lines = 15);
 
 // Width and height set by an INI file (Width=, Height=, +W, +H before the first [section]);
-// 0 for a value it does not set. Throws ssao_io::Error if the file cannot be read.
+// 0 for a value it does not set. Throws ssao_tools::Error if the file cannot be read.
 void ini_size(const std::string& path, int& width, int& height);
 
 // The library paths an INI file adds (Library_Path=..., +L...), appended to `paths`.
@@ -101,15 +102,7 @@ class ScratchFolder {
   std::string path_;
 };
 
-// SIGINT and SIGTERM set a flag instead of killing the bridge (so that the scratch folder is
-// removed and no partial output is left); installed for the lifetime of the object.
-class InterruptGuard {
- public:
-  InterruptGuard();
-  ~InterruptGuard();
-  InterruptGuard(const InterruptGuard&) = delete;
-  InterruptGuard& operator=(const InterruptGuard&) = delete;
-  static bool interrupted();
-};
+// Ctrl-C: the tools' one guard (the scratch folder is removed, no partial output is left).
+using ssao_tools::InterruptGuard;
 
 }  // namespace povray_ssao

@@ -104,7 +104,8 @@ std::vector<Token> tokenize(const std::string& text, const std::string& file) {
         }
       }
       if (depth != 0) {
-        throw ssao_io::Error(file + ":" + std::to_string(start_line) + ": unterminated /* comment");
+        throw ssao_tools::Error(file + ":" + std::to_string(start_line) +
+                                ": unterminated /* comment");
       }
       continue;
     }
@@ -122,7 +123,7 @@ std::vector<Token> tokenize(const std::string& text, const std::string& file) {
         value += text[i++];
       }
       if (i >= n) {
-        throw ssao_io::Error(file + ":" + std::to_string(start_line) + ": unterminated string");
+        throw ssao_tools::Error(file + ":" + std::to_string(start_line) + ": unterminated string");
       }
       ++i;
       Token token = make(Token::kString, value);
@@ -847,7 +848,7 @@ class Scanner {
 
   void scan_file(const std::string& path, const std::string& display, int depth) {
     std::ifstream file(path, std::ios::binary);
-    if (!file) throw ssao_io::Error("cannot read the scene file '" + path + "'");
+    if (!file) throw ssao_tools::Error("cannot read the scene file '" + path + "'");
     std::ostringstream text;
     text << file.rdbuf();
     const std::vector<Token> tokens = tokenize(text.str(), display);
@@ -1021,7 +1022,7 @@ class Scanner {
     settings_end_ = 0;
     try {
       scan_file(path.string(), name, depth + 1);
-    } catch (const ssao_io::Error& e) {
+    } catch (const ssao_tools::Error& e) {
       result.notes.push_back(std::string("could not read the include file '") + name + "' (" +
                              e.what() + ")");
     }

@@ -12,7 +12,7 @@
 #include <string>
 #include <vector>
 
-#include "io/error.h"
+#include "tools/error.h"
 
 namespace povray_ssao {
 
@@ -54,7 +54,7 @@ struct Token {
 };
 
 // Splits SDL text into tokens; comments (// and nested /* */) and whitespace dropped. The last
-// token is kEnd. Throws ssao_io::Error for an unterminated string or comment.
+// token is kEnd. Throws ssao_tools::Error for an unterminated string or comment.
 std::vector<Token> tokenize(const std::string& text, const std::string& file);
 
 // True if `token` is the punctuation `text`.
@@ -87,9 +87,9 @@ struct EvalContext {
 };
 
 // Thrown when an expression uses something the evaluator cannot evaluate; the message names it.
-class EvalError : public ssao_io::Error {
+class EvalError : public ssao_tools::Error {
  public:
-  using ssao_io::Error::Error;
+  using ssao_tools::Error::Error;
 };
 
 // Evaluates the expression starting at tokens[pos] (a number or vector expression); on return
@@ -185,7 +185,7 @@ struct ScanSettings {
 // skipped). #if/#ifdef/#ifndef/#elseif/#else/#switch/#case/#range conditions that can be
 // evaluated select their branch as POV-Ray would; the others, and loops, are read entirely
 // (cameras found there are marked conditional). Macro bodies are not read. Throws
-// ssao_io::Error if `path` cannot be read or tokenized.
+// ssao_tools::Error if `path` cannot be read or tokenized.
 SceneScan scan_scene(const std::string& path, const ScanSettings& settings);
 
 }  // namespace povray_ssao

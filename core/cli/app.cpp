@@ -10,12 +10,13 @@
 #include <future>
 #include <string>
 
-#include "io/blender_passes.h"
-#include "io/camera_json.h"
-#include "io/frames.h"
-#include "io/image_io.h"
-#include "io/job.h"
-#include "progress.h"
+#include "ssao/ssao.hpp"
+#include "tools/blender_passes.h"
+#include "tools/camera_json.h"
+#include "tools/files.h"
+#include "tools/frames.h"
+#include "tools/image_io.h"
+#include "tools/progress.h"
 
 namespace ssao_cli {
 namespace {
@@ -26,8 +27,8 @@ namespace fs = std::filesystem;
 // whose data window is larger than its display window) the passes hold the whole data window:
 // the AO of the frame (image.frame_*) is computed from all of it.
 struct Inputs {
-  ssao_io::Image image;
-  ssao_io::PassChannels passes;
+  ssao_tools::Image image;
+  ssao_tools::PassChannels passes;
   std::vector<float> depth;   // 1 channel
   std::vector<float> normal;  // 3 channels or empty
   std::vector<float> beauty;  // 3 or 4 channels or empty
@@ -42,11 +43,8 @@ struct Outputs {
   std::vector<float> composite;  // as many channels as the beauty, empty with --ao-only
 };
 
-bool same_file(const std::string& a, const std::string& b) {
-  std::error_code ec;
-  if (fs::exists(a, ec) && fs::exists(b, ec)) return fs::equivalent(a, b, ec);
-  return fs::weakly_canonical(a, ec) == fs::weakly_canonical(b, ec);
-}
+using ssao_tools::ProgressReporter;
+using ssao_tools::same_file;
 
 void refuse_overwriting_inputs(const Options& options) {
   if (same_file(options.output, options.input)) {
@@ -59,26 +57,16 @@ void refuse_overwriting_inputs(const Options& options) {
 
 // Fails before any work when the output cannot be created (the final write would fail anyway).
 void check_output_folder(const Options& options) {
-  fs::path folder = fs::path(options.output).parent_path();
-  if (folder.empty()) folder = ".";
-  std::error_code ec;
-  if (!fs::is_directory(folder, ec)) {
-    throw ssao_io::Error("cannot write '" + options.output + "': no folder '" + folder.string() +
-                         "'");
-  }
-  if (::access(folder.c_str(), W_OK) != 0) {
-    throw ssao_io::Error("cannot write '" + options.output + "': folder '" + folder.string() +
-                         "' is not writable");
-  }
+  ssao_tools::check_output_folder(options.output);
   const std::string extension = fs::path(options.output).extension().string();
-  if (extension != ".exr" && !ssao_io::is_preview_path(options.output)) {
-    throw ssao_io::Error("cannot write '" + options.output + "': use .exr (linear float data) " +
-                         "or .png, .jpg, .tif (an 8-bit sRGB preview)");
+  if (extension != ".exr" && !ssao_tools::is_preview_path(options.output)) {
+    throw ssao_tools::Error("cannot write '" + options.output + "': use .exr (linear float data) " +
+                            "or .png, .jpg, .tif (an 8-bit sRGB preview)");
   }
 }
 
-ssao_io::Camera load_camera(const Options& options) {
-  ssao_io::Camera camera = ssao_io::read_camera_json(options.camera);
+ssao_tools::Camera load_camera(const Options& options) {
+  ssao_tools::Camera camera = ssao_tools::read_camera_json(options.camera);
   if (!options.quiet) {
     for (const std::string& key : camera.unknown_keys) {
       std::fprintf(stderr, "ssao: warning: camera file '%s': unknown key '%s' ignored\n",
@@ -90,8 +78,8 @@ ssao_io::Camera load_camera(const Options& options) {
 
 Inputs load_inputs(const Options& options) {
   Inputs in;
-  in.image = ssao_io::read_image(options.input, ssao_io::Overscan::read);
-  ssao_io::PassOverrides overrides;
+  in.image = ssao_tools::read_image(options.input, ssao_tools::Overscan::read);
+  ssao_tools::PassOverrides overrides;
   overrides.layer = options.layer;
   overrides.depth_channel = options.depth_channel;
   overrides.normal_channels = options.normal_channels;
@@ -99,22 +87,23 @@ Inputs load_inputs(const Options& options) {
   overrides.no_normals = options.no_normals;
   overrides.depth_layers = options.depth_layers;
   overrides.no_depth_layers = options.no_depth_layers;
-  in.passes = ssao_io::detect_passes(in.image.channel_names, overrides, options.input);
+  in.passes = ssao_tools::detect_passes(in.image.channel_names, overrides, options.input);
   if (options.ao_only) in.passes.beauty.clear();
   if (!options.ao_only && in.passes.beauty.empty()) {
-    throw ssao_io::Error("'" + options.input + "' has no beauty pass (looked for " +
-                         (in.passes.layer.empty() ? "" : in.passes.layer + ".") +
-                         "Combined.R/G/B); use --ao-only to write AO alone, or name the beauty " +
-                         "channels with --beauty-channels R,G,B[,A]");
+    throw ssao_tools::Error(
+        "'" + options.input + "' has no beauty pass (looked for " +
+        (in.passes.layer.empty() ? "" : in.passes.layer + ".") +
+        "Combined.R/G/B); use --ao-only to write AO alone, or name the beauty " +
+        "channels with --beauty-channels R,G,B[,A]");
   }
 
   const auto pass = [&](const std::vector<std::string>& names) {
-    return ssao_io::extract_named_channels(in.image, names, options.input);
+    return ssao_tools::extract_named_channels(in.image, names, options.input);
   };
   in.depth = pass({in.passes.depth});
   if (!in.passes.normal.empty()) in.normal = pass(in.passes.normal);
   if (!in.passes.beauty.empty()) in.beauty = pass(in.passes.beauty);
-  for (const ssao_io::DepthLayerChannels& layer : in.passes.depth_layers) {
+  for (const ssao_tools::DepthLayerChannels& layer : in.passes.depth_layers) {
     in.layer_depth.push_back(pass({layer.depth}));
     in.layer_facing.push_back(layer.facing.empty() ? std::vector<float>() : pass({layer.facing}));
   }
@@ -123,8 +112,8 @@ Inputs load_inputs(const Options& options) {
   return in;
 }
 
-void attach_images(ssao_io::Job& job, Inputs& in, Outputs& out) {
-  const ssao_io::Image& image = in.image;
+void attach_images(ssao::api::Job& job, Inputs& in, Outputs& out) {
+  const ssao_tools::Image& image = in.image;
   job.set_image("depth", in.depth.data(), image.width, image.height, 1);
   if (!in.normal.empty()) job.set_image("normal", in.normal.data(), image.width, image.height, 3);
   for (size_t k = 0; k < in.layer_depth.size(); ++k) {
@@ -143,7 +132,7 @@ void attach_images(ssao_io::Job& job, Inputs& in, Outputs& out) {
   if (!in.beauty.empty()) {
     const int channels = in.beauty_channels();
     out.composite.assign(image.frame_pixel_count() * size_t(channels), 0.0f);
-    const ssao_io::FrameView beauty = ssao_io::frame_view(image, in.beauty, channels);
+    const ssao_tools::FrameView beauty = ssao_tools::frame_view(image, in.beauty, channels);
     job.set_image("beauty", beauty.data, w, h, channels, beauty.pixel_stride, beauty.row_stride);
     job.set_image("composite", out.composite.data(), w, h, channels);
   }
@@ -151,18 +140,19 @@ void attach_images(ssao_io::Job& job, Inputs& in, Outputs& out) {
 
 // World-space normals are turned through the camera's matrix: a camera file without one would
 // leave them unturned and the AO silently wrong, so such a run is refused.
-void require_camera_for_normals(const ssao_io::Job& job, const Inputs& in,
-                                const ssao_io::Camera& camera, const std::string& camera_path) {
+void require_camera_for_normals(const ssao::api::Job& job, const Inputs& in,
+                                const ssao_tools::Camera& camera, const std::string& camera_path) {
   if (in.normal.empty() || camera.has_matrix_world) return;
   if (job.get_string("normal_space") != "world") return;
-  throw ssao_io::Error("camera file '" + camera_path +
-                       "': missing key 'matrix_world', which the world-space normal pass needs; " +
-                       "add it, or pass --normal-space camera for view-space normals, or " +
-                       "--no-normals to reconstruct normals from depth");
+  throw ssao_tools::Error(
+      "camera file '" + camera_path +
+      "': missing key 'matrix_world', which the world-space normal pass needs; " +
+      "add it, or pass --normal-space camera for view-space normals, or " +
+      "--no-normals to reconstruct normals from depth");
 }
 
 // Runs the job with progress on stderr; returns the time spent in milliseconds.
-double compute_ao(ssao_io::Job& job, bool quiet) {
+double compute_ao(ssao::api::Job& job, bool quiet) {
   ProgressReporter progress(quiet);
   job.set_progress(&ProgressReporter::callback, &progress);
   const auto start = std::chrono::steady_clock::now();
@@ -171,16 +161,16 @@ double compute_ao(ssao_io::Job& job, bool quiet) {
   progress.finish();
   job.set_progress(nullptr, nullptr);
   if (status == SSAO_ERROR_CANCELLED || ProgressReporter::interrupted()) {
-    throw ssao_io::Error("interrupted; nothing written");
+    throw ssao_tools::Error("interrupted; nothing written");
   }
-  ssao_io::check_status(status, "SSAO failed");
+  ssao::api::check_status(status, "SSAO failed");
   return std::chrono::duration<double, std::milli>(stop - start).count();
 }
 
 // The output file's channels: beauty's (named R, G, B[, A]) x AO then AO, or AO alone.
 void write_output(const Options& options, const Inputs& in, const Outputs& out) {
-  const auto write =
-      ssao_io::is_preview_path(options.output) ? ssao_io::write_preview : ssao_io::write_exr;
+  const auto write = ssao_tools::is_preview_path(options.output) ? ssao_tools::write_preview
+                                                                 : ssao_tools::write_exr;
   const size_t pixels = in.image.frame_pixel_count();
   const int width = in.image.frame_width, height = in.image.frame_height;
   if (out.composite.empty()) {
@@ -207,10 +197,11 @@ bool is_geometry(float depth, double background_depth, double clip_end) {
 }
 
 // Mean AO over the frame's geometry pixels ("n/a" without any) and their count.
-std::string mean_ao(const ssao_io::Job& job, const Inputs& in, const Outputs& out, size_t& count) {
+std::string mean_ao(const ssao::api::Job& job, const Inputs& in, const Outputs& out,
+                    size_t& count) {
   const double background_depth = job.get_float("background_depth");
   const double clip_end = job.get_float("clip_end");
-  const ssao_io::Image& image = in.image;
+  const ssao_tools::Image& image = in.image;
   double sum = 0.0;
   count = 0;
   for (int y = 0; y < image.frame_height; ++y) {
@@ -227,7 +218,7 @@ std::string mean_ao(const ssao_io::Job& job, const Inputs& in, const Outputs& ou
   return mean;
 }
 
-void print_summary(const Options& options, const ssao_io::Job& job, const Inputs& in,
+void print_summary(const Options& options, const ssao::api::Job& job, const Inputs& in,
                    const Outputs& out, double milliseconds) {
   size_t count = 0;
   const std::string mean = mean_ao(job, in, out, count);
@@ -241,8 +232,8 @@ void print_summary(const Options& options, const ssao_io::Job& job, const Inputs
 
 // Without --radius: the camera file's ao_distance, else the core's automatic rule; said on
 // stderr with how to change it.
-void choose_radius(const Options& options, const ssao_io::Camera& camera, ssao_io::Job& job) {
-  for (const ssao_io::ParamSetting& setting : options.params) {
+void choose_radius(const Options& options, const ssao_tools::Camera& camera, ssao::api::Job& job) {
+  for (const ssao_tools::ParamSetting& setting : options.params) {
     if (setting.name == "radius") return;
   }
   std::string why;
@@ -264,13 +255,13 @@ void choose_radius(const Options& options, const ssao_io::Camera& camera, ssao_i
 
 // One frame of a sequence, read ahead while the previous one computes.
 struct FrameInputs {
-  ssao_io::Camera camera;
+  ssao_tools::Camera camera;
   Inputs in;
 };
 
-Options frame_options(const Options& options, const ssao_io::FramePattern& input,
-                      const ssao_io::FramePattern& output, const ssao_io::FramePattern& camera,
-                      int frame) {
+Options frame_options(const Options& options, const ssao_tools::FramePattern& input,
+                      const ssao_tools::FramePattern& output,
+                      const ssao_tools::FramePattern& camera, int frame) {
   Options o = options;
   o.input = input.path(frame);
   o.output = output.path(frame);
@@ -311,11 +302,11 @@ std::string json_string(const std::string& text) {
 
 // --frames: every frame independently; the failures are reported and listed at the end.
 void run_sequence(const Options& options) {
-  const ssao_io::FramePattern input(options.input), output(options.output);
+  const ssao_tools::FramePattern input(options.input), output(options.output);
   // A camera file that exists under its own name serves every frame (its name may hold '@').
-  const ssao_io::FramePattern camera = fs::is_regular_file(options.camera)
-                                           ? ssao_io::FramePattern::literal(options.camera)
-                                           : ssao_io::FramePattern(options.camera);
+  const ssao_tools::FramePattern camera = fs::is_regular_file(options.camera)
+                                              ? ssao_tools::FramePattern::literal(options.camera)
+                                              : ssao_tools::FramePattern(options.camera);
   if (!input.has_frame() || !output.has_frame()) {
     throw UsageError(std::string("with --frames, ") + (input.has_frame() ? "-o" : "the input") +
                      " needs a frame placeholder (#### for 4 digits, @, or %04d)");
@@ -332,7 +323,7 @@ void run_sequence(const Options& options) {
   }
 
   ProgressReporter interrupt(true);  // Ctrl-C stops after the frame in progress
-  ssao_io::Job job;
+  ssao::api::Job job;
   const size_t total = options.frames.size();
   std::vector<int> failed;
   size_t written = 0, skipped = 0;
@@ -374,8 +365,8 @@ void run_sequence(const Options& options) {
         next_index = prefetch(i + 1);  // read the next frame while this one computes
         refuse_overwriting_inputs(o);
         check_output_folder(o);
-        ssao_io::apply_camera(job.get(), f.camera, o.camera);
-        ssao_io::apply_params(job, o.params);
+        ssao_tools::apply_camera(job.get(), f.camera, o.camera);
+        ssao_tools::apply_params(job, o.params);
         Outputs out;
         attach_images(job, f.in, out);
         require_camera_for_normals(job, f.in, f.camera, o.camera);
@@ -384,9 +375,9 @@ void run_sequence(const Options& options) {
         const ssao_status result = ssao_job_run(job.get());
         job.set_progress(nullptr, nullptr);
         if (result == SSAO_ERROR_CANCELLED || ProgressReporter::interrupted()) {
-          throw ssao_io::Error("interrupted");
+          throw ssao_tools::Error("interrupted");
         }
-        ssao_io::check_status(result, "SSAO failed");
+        ssao::api::check_status(result, "SSAO failed");
         write_output(o, f.in, out);
         size_t count = 0;
         mean = mean_ao(job, f.in, out, count);
@@ -430,8 +421,8 @@ void run_sequence(const Options& options) {
     std::fflush(stderr);
     if (ProgressReporter::interrupted()) {
       if (next.valid()) next.wait();
-      throw ssao_io::Error("interrupted after frame " + std::to_string(frame) + ": " +
-                           std::to_string(written) + " frames written");
+      throw ssao_tools::Error("interrupted after frame " + std::to_string(frame) + ": " +
+                              std::to_string(written) + " frames written");
     }
   }
   const double wall =
@@ -457,10 +448,11 @@ void run_sequence(const Options& options) {
 }  // namespace
 
 void list_chunks(const Options& options) {
-  const size_t count = ssao_io::chunk_count(options.frames.size(), options.chunk_size);
+  const size_t count = ssao_tools::chunk_count(options.frames.size(), options.chunk_size);
   for (size_t index = 0; index < count; ++index) {
-    const std::vector<int> chunk = ssao_io::chunk_frames(options.frames, options.chunk_size, index);
-    std::printf("%zu %s\n", index, ssao_io::format_frames(chunk).c_str());
+    const std::vector<int> chunk =
+        ssao_tools::chunk_frames(options.frames, options.chunk_size, index);
+    std::printf("%zu %s\n", index, ssao_tools::format_frames(chunk).c_str());
   }
 }
 
@@ -471,11 +463,11 @@ void run_ssao(const Options& options) {
   }
   refuse_overwriting_inputs(options);
   check_output_folder(options);
-  const ssao_io::Camera camera = load_camera(options);
+  const ssao_tools::Camera camera = load_camera(options);
 
-  ssao_io::Job job;
-  ssao_io::apply_camera(job.get(), camera, options.camera);
-  ssao_io::apply_params(job, options.params);  // after the camera: a flag overrides the file
+  ssao::api::Job job;
+  ssao_tools::apply_camera(job.get(), camera, options.camera);
+  ssao_tools::apply_params(job, options.params);  // after the camera: a flag overrides the file
 
   Inputs in = load_inputs(options);
   Outputs out;

@@ -4,16 +4,16 @@
 #include <string>
 #include <vector>
 
-#include "io/camera_json.h"
-#include "io/frames.h"
+#include "tools/camera_json.h"
+#include "tools/frames.h"
 
 namespace ssao_cli {
 namespace {
 
-using ssao_io::find_param;
-using ssao_io::help_entry;
-using ssao_io::parse_param;
-using ssao_io::split;
+using ssao_tools::find_param;
+using ssao_tools::help_entry;
+using ssao_tools::parse_param;
+using ssao_tools::split;
 
 std::vector<std::string> parse_channel_list(const std::string& flag, const std::string& text,
                                             size_t min_count, size_t max_count) {
@@ -33,7 +33,7 @@ std::vector<std::string> parse_channel_list(const std::string& flag, const std::
 
 // Front-end options (not core parameters). The table drives parsing, --help and suggestions.
 enum Group { kInputOutput, kOther };
-using FrontOption = ssao_io::FrontOption<Options, Group>;
+using FrontOption = ssao_tools::FrontOption<Options, Group>;
 
 const std::vector<FrontOption>& front_options() {
   static const std::vector<FrontOption> options = {
@@ -52,8 +52,8 @@ const std::vector<FrontOption>& front_options() {
        "1,5,9-12. A frame that fails is reported and the others are still written",
        [](Options& o, const std::string& f, const std::string& v) {
          try {
-           o.frames = ssao_io::parse_frames(v);
-         } catch (const ssao_io::Error& e) {
+           o.frames = ssao_tools::parse_frames(v);
+         } catch (const ssao_tools::Error& e) {
            throw UsageError(std::string(e.what()) + " (" + f + ")");
          }
          o.frames_text = v;
@@ -66,14 +66,14 @@ const std::vector<FrontOption>& front_options() {
        "with --frames, for farms: cut the frame list, in order, into chunks of N frames (the "
        "last one may be shorter); see --chunk-index, --list-chunks and docs/farm.md",
        [](Options& o, const std::string& f, const std::string& v) {
-         const int size = ssao_io::parse_int(f, v);
+         const int size = ssao_tools::parse_int(f, v);
          if (size < 1) throw UsageError(f + " must be at least 1, got " + v);
          o.chunk_size = size_t(size);
        }},
       {kInputOutput, "--chunk-index", nullptr, "I",
        "with --chunk-size: process only chunk I (0 is the first), e.g. $SLURM_ARRAY_TASK_ID",
        [](Options& o, const std::string& f, const std::string& v) {
-         const int index = ssao_io::parse_int(f, v);
+         const int index = ssao_tools::parse_int(f, v);
          if (index < 0) throw UsageError(f + " must be 0 or more, got " + v);
          o.chunk_index = index;
        }},
@@ -122,8 +122,9 @@ const std::vector<FrontOption>& front_options() {
            throw UsageError(f + ": expected DEPTH_CHANNEL or DEPTH_CHANNEL:FACING_CHANNEL, got '" +
                             v + "'");
          }
-         if (o.depth_layers.size() == ssao_io::kMaxDepthLayers) {
-           throw UsageError(f + " is given more than " + std::to_string(ssao_io::kMaxDepthLayers) +
+         if (o.depth_layers.size() == ssao_tools::kMaxDepthLayers) {
+           throw UsageError(f + " is given more than " +
+                            std::to_string(ssao_tools::kMaxDepthLayers) +
                             " times: the library takes the 2nd to the 5th hit");
          }
          o.depth_layers.push_back({depth, facing});
@@ -160,8 +161,8 @@ void apply_chunking(Options& options) {
   if (options.chunk_index >= 0) {
     try {
       options.frames =
-          ssao_io::chunk_frames(options.frames, options.chunk_size, size_t(options.chunk_index));
-    } catch (const ssao_io::Error& e) {
+          ssao_tools::chunk_frames(options.frames, options.chunk_size, size_t(options.chunk_index));
+    } catch (const ssao_tools::Error& e) {
       throw UsageError(std::string("--chunk-index: ") + e.what() + " (--frames " +
                        options.frames_text + ")");
     }
@@ -189,7 +190,7 @@ void require_complete(const Options& options) {
 
 Options parse_args(int argc, const char* const* argv, const std::vector<ssao_param_desc>& table) {
   Options out;
-  if (ssao_io::scan_help_and_version(argc, argv, out)) return out;
+  if (ssao_tools::scan_help_and_version(argc, argv, out)) return out;
 
   bool only_positionals = false;
   for (int i = 1; i < argc; ++i) {
@@ -208,7 +209,7 @@ Options parse_args(int argc, const char* const* argv, const std::vector<ssao_par
       continue;
     }
 
-    ssao_io::parse_option(argc, argv, i, front_options(), table, out);
+    ssao_tools::parse_option(argc, argv, i, front_options(), table, out);
   }
   apply_chunking(out);
   require_complete(out);
@@ -246,8 +247,8 @@ std::string usage_text(const std::vector<ssao_param_desc>& table) {
 
   auto param_section = [&](const char* title, bool camera) {
     text += std::string("\n") + title + "\n";
-    text += ssao_io::param_help(table, [camera](const ssao_param_desc& desc) {
-      return ssao_io::is_camera_param(desc.name) == camera;
+    text += ssao_tools::param_help(table, [camera](const ssao_param_desc& desc) {
+      return ssao_tools::is_camera_param(desc.name) == camera;
     });
   };
   param_section(

@@ -7,17 +7,17 @@
 #include <string>
 #include <vector>
 
-#include "io/blender_passes.h"
-#include "io/param_flags.h"
 #include "ssao/ssao.h"
+#include "tools/blender_passes.h"
+#include "tools/param_flags.h"
 
 namespace ssao_cli {
 
 // A wrong command line: reported with a hint to --help, exit status 2. The parameter flags
 // (--NAME-WITH-DASHES, parsing, help) are shared with the other front ends: io/param_flags.h.
-using ssao_io::flag_for;
-using ssao_io::ParamSetting;
-using ssao_io::UsageError;
+using ssao_tools::flag_for;
+using ssao_tools::ParamSetting;
+using ssao_tools::UsageError;
 
 struct Options {
   bool help = false;
@@ -33,7 +33,7 @@ struct Options {
   std::vector<std::string> normal_channels;
   std::vector<std::string> beauty_channels;
   // --depth-layer DEPTH[:FACING], in hit order (the first names the 2nd hit).
-  std::vector<ssao_io::DepthLayerChannels> depth_layers;
+  std::vector<ssao_tools::DepthLayerChannels> depth_layers;
   bool no_depth_layers = false;
   std::vector<ParamSetting> params;  // in command-line order
   // Sequences: IN, -o and --camera are patterns (#, @, %04d) with --frames.

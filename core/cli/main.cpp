@@ -1,40 +1,25 @@
 // SPDX-License-Identifier: MIT
 // ssao: screen-space ambient occlusion of a rendered EXR. See --help, args.cpp and app.cpp.
 #include <cstdio>
-#include <exception>
-#include <new>
 
 #include "app.h"
 #include "args.h"
-#include "io/job.h"
+#include "ssao/ssao.hpp"
+#include "tools/tool_main.h"
 
 int main(int argc, char** argv) {
-  try {
-    const std::vector<ssao_param_desc> table = ssao_io::param_table();
+  return ssao_tools::tool_main("ssao", [&] {
+    const std::vector<ssao_param_desc> table = ssao::api::param_table();
     const ssao_cli::Options options = ssao_cli::parse_args(argc, argv, table);
     if (options.help) {
       std::fputs(ssao_cli::usage_text(table).c_str(), stdout);
-      return 0;
-    }
-    if (options.version) {
-      std::printf("ssao %s\n", ssao_io::version_string(ssao_version()).c_str());
-      return 0;
-    }
-    if (options.list_chunks) {
+    } else if (options.version) {
+      std::printf("ssao %s\n", ssao::api::version_string(ssao_version()).c_str());
+    } else if (options.list_chunks) {
       ssao_cli::list_chunks(options);
-      return 0;
+    } else {
+      ssao_cli::run_ssao(options);
     }
-    ssao_cli::run_ssao(options);
     return 0;
-  } catch (const ssao_cli::UsageError& e) {
-    std::fprintf(stderr, "ssao: error: %s\nTry 'ssao --help' for more information.\n", e.what());
-    return 2;
-  } catch (const std::bad_alloc&) {
-    std::fprintf(stderr, "ssao: error: out of memory\n");
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "ssao: error: %s\n", e.what());
-  } catch (...) {
-    std::fprintf(stderr, "ssao: error: unexpected exception\n");
-  }
-  return 1;
+  });
 }

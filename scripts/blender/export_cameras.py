@@ -54,7 +54,7 @@ except ImportError:  # plain Python: the frame and file name parsing below still
     bpy = None
 
 PROG = "export_cameras"
-MAX_FRAMES = 1000000  # as the CLI (core/io/frames.h: kMaxFrames)
+MAX_FRAMES = 1000000  # as the CLI (core/tools/frames.h: kMaxFrames)
 BLENDER_FRAMES = (-1048574, 1048574)  # Blender's MINAFRAME, MAXFRAME: frame_set() clamps to it
 SUPPORTED_TYPES = ("PERSP", "ORTHO")  # the library has no panoramic camera
 
@@ -131,7 +131,7 @@ def write_json(path, data):
 
 
 # ---------------------------------------------------------------------------
-# Frames and file name patterns, as the CLI reads them (core/io/frames.cpp)
+# Frames and file name patterns, as the CLI reads them (core/tools/frames.cpp)
 
 class UsageError(Exception):
     """A command-line error (exit status 2)."""

@@ -1,8 +1,8 @@
 // SPDX-License-Identifier: MIT
 // libFuzzer target: the camera file of the command-line tool (--camera) on random text:
-// ssao_io::parse_camera_json (nlohmann-json), then apply_camera onto a job as the CLI does. Both
-// must either work or throw ssao_io::Error. A camera that parses must hold what the format
-// promises (core/io/camera_json.h): finite numbers, known choices, an affine matrix.
+// ssao_tools::parse_camera_json (nlohmann-json), then apply_camera onto a job as the CLI does. Both
+// must either work or throw ssao_tools::Error. A camera that parses must hold what the format
+// promises (core/tools/camera_json.h): finite numbers, known choices, an affine matrix.
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
@@ -10,8 +10,8 @@
 #include <string>
 
 #include "fuzz_common.h"
-#include "io/camera_json.h"
-#include "io/job.h"
+#include "ssao/ssao.hpp"
+#include "tools/camera_json.h"
 
 namespace {
 
@@ -21,10 +21,10 @@ using fuzz::check;
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   const std::string text(reinterpret_cast<const char*>(data), size);
-  ssao_io::Camera camera;
+  ssao_tools::Camera camera;
   try {
-    camera = ssao_io::parse_camera_json(text, "fuzz.camera.json");
-  } catch (const ssao_io::Error&) {
+    camera = ssao_tools::parse_camera_json(text, "fuzz.camera.json");
+  } catch (const ssao_tools::Error&) {
     return 0;  // refused with a message: what the CLI prints
   }
   check(camera.type == "PERSP" || camera.type == "ORTHO", "unknown type accepted");
@@ -40,10 +40,10 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   check(camera.matrix_world[12] == 0.0 && camera.matrix_world[13] == 0.0 &&
             camera.matrix_world[14] == 0.0 && camera.matrix_world[15] == 1.0,
         "a non-affine matrix accepted");
-  ssao_io::Job job;
+  ssao::api::Job job;
   try {
-    ssao_io::apply_camera(job.get(), camera, "fuzz.camera.json");
-  } catch (const ssao_io::Error&) {
+    ssao_tools::apply_camera(job.get(), camera, "fuzz.camera.json");
+  } catch (const ssao::api::Error&) {
     // The core refused a value (e.g. a lens outside its range): the CLI reports it.
   }
   return 0;

@@ -1,9 +1,9 @@
 // SPDX-License-Identifier: MIT
 // libFuzzer target: the command-line tool's input path on EXR files. The file goes the way
-// build/bin/ssao takes its --input (core/cli/app.cpp load_inputs): ssao_io::read_image
+// build/bin/ssao takes its --input (core/cli/app.cpp load_inputs): ssao_tools::read_image
 // (OpenImageIO in the module libssao_image_codec.so), linearize, detect_passes on its channel
 // names, extract_channels of depth, normal and beauty, and, for small images, a run of the
-// library on them. Everything must either work or throw ssao_io::Error; an image that reads must
+// library on them. Everything must either work or throw ssao_tools::Error; an image that reads must
 // be consistent (as many floats as width x height x channels, the passes chosen exist).
 //
 // The file is made from the input, in one of two ways:
@@ -18,7 +18,7 @@
 //   the file.
 // Raw bytes are not fuzzed: Debian's OpenEXR 3.1, not instrumented and not this project's,
 // allocates what a damaged header claims (gigabytes for a 300-byte file) in more places than
-// core/io/image_codec.cpp's header check can cover without rewriting OpenEXR's parser, and under
+// core/tools/image_codec.cpp's header check can cover without rewriting OpenEXR's parser, and under
 // AddressSanitizer an allocation that large ends the process instead of throwing bad_alloc.
 // Every mutated header would be an OpenEXR finding, not one of this project's code.
 #include <OpenImageIO/imageio.h>
@@ -33,19 +33,19 @@
 #include <vector>
 
 #include "fuzz_common.h"
-#include "io/blender_passes.h"
-#include "io/image_io.h"
-#include "io/job.h"
+#include "ssao/ssao.hpp"
+#include "tools/blender_passes.h"
+#include "tools/image_io.h"
 
 namespace {
 
 using fuzz::check;
 
-std::vector<int> indices_of(const ssao_io::Image& image, const std::vector<std::string>& names,
+std::vector<int> indices_of(const ssao_tools::Image& image, const std::vector<std::string>& names,
                             const std::string& path) {
   std::vector<int> indices;
   for (const std::string& name : names) {
-    indices.push_back(ssao_io::require_channel(image, name, path));
+    indices.push_back(ssao_tools::require_channel(image, name, path));
   }
   return indices;
 }
@@ -168,10 +168,10 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     }
   }
 
-  ssao_io::Image image;
+  ssao_tools::Image image;
   try {
-    image = ssao_io::read_image(path, ssao_io::Overscan::read);
-  } catch (const ssao_io::Error&) {
+    image = ssao_tools::read_image(path, ssao_tools::Overscan::read);
+  } catch (const ssao_tools::Error&) {
     return 0;  // refused with a message: what the CLI prints
   }
   check(image.width >= 0 && image.height >= 0, "negative size");
@@ -181,12 +181,12 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
         "the display window is not inside the data window read");
   check(image.pixels.size() == image.pixel_count() * size_t(image.channels()),
         "pixel buffer does not match width x height x channels");
-  ssao_io::linearize(image);
+  ssao_tools::linearize(image);
 
-  ssao_io::PassChannels passes;
+  ssao_tools::PassChannels passes;
   try {
-    passes = ssao_io::detect_passes(image.channel_names, ssao_io::PassOverrides{}, path);
-  } catch (const ssao_io::Error&) {
+    passes = ssao_tools::detect_passes(image.channel_names, ssao_tools::PassOverrides{}, path);
+  } catch (const ssao_tools::Error&) {
     return 0;
   }
   check(!passes.depth.empty(), "detect_passes returned no depth channel");
@@ -195,14 +195,14 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
         "beauty pass is not 3 or 4 channels");
   std::vector<float> depth, normal, beauty;
   try {
-    depth = ssao_io::extract_channels(image, indices_of(image, {passes.depth}, path));
+    depth = ssao_tools::extract_channels(image, indices_of(image, {passes.depth}, path));
     if (!passes.normal.empty()) {
-      normal = ssao_io::extract_channels(image, indices_of(image, passes.normal, path));
+      normal = ssao_tools::extract_channels(image, indices_of(image, passes.normal, path));
     }
     if (!passes.beauty.empty()) {
-      beauty = ssao_io::extract_channels(image, indices_of(image, passes.beauty, path));
+      beauty = ssao_tools::extract_channels(image, indices_of(image, passes.beauty, path));
     }
-  } catch (const ssao_io::Error&) {
+  } catch (const ssao_tools::Error&) {
     check(false, "a channel detect_passes chose does not exist");
   }
   check(depth.size() == image.pixel_count(), "depth size");
@@ -212,7 +212,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   const int w = image.width, h = image.height;
   const int fw = image.frame_width, fh = image.frame_height;
   try {
-    ssao_io::Job job;
+    ssao::api::Job job;
     job.set("threads", 1);
     job.set_image("depth", depth.data(), w, h, 1);
     if (!normal.empty()) job.set_image("normal", normal.data(), w, h, 3);
@@ -222,14 +222,14 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
         composite(image.frame_pixel_count() * size_t(beauty_channels));
     job.set_image("ao", ao.data(), fw, fh, 1);
     if (!beauty.empty()) {
-      const ssao_io::FrameView view = ssao_io::frame_view(image, beauty, beauty_channels);
+      const ssao_tools::FrameView view = ssao_tools::frame_view(image, beauty, beauty_channels);
       job.set_image("beauty", view.data, fw, fh, beauty_channels, view.pixel_stride,
                     view.row_stride);
       job.set_image("composite", composite.data(), fw, fh, beauty_channels);
     }
     job.run();
     for (float v : ao) check(v >= 0.0f && v <= 1.0f, "AO outside [0, 1] or NaN");
-  } catch (const ssao_io::CoreError& e) {
+  } catch (const ssao::api::Error& e) {
     // The images are valid for the library whatever their values (the camera is the default).
     std::fprintf(stderr, "fuzz_exr: the library refused a readable image: %s\n", e.what());
     std::abort();

@@ -4,7 +4,7 @@
 // to a scratch folder; its #include files resolve there and in povray_bridge/pov), read_camera
 // on the scan, then the camera's SDL, summary, pixel mapping and the library's camera
 // parameters. Also tokenize + evaluate_full from every token of the text (the evaluator behind
-// #declare, #if and the camera's values). Everything must work or throw ssao_io::Error (the
+// #declare, #if and the camera's values). Everything must work or throw ssao_tools::Error (the
 // evaluator's EvalError is one); a camera that reads must have finite vectors, since povray-ssao
 // writes them into every pass's scene.
 #include <cmath>
@@ -15,9 +15,9 @@
 #include <vector>
 
 #include "fuzz_common.h"
-#include "io/job.h"
 #include "pov_camera.h"
 #include "sdl.h"
+#include "ssao/ssao.hpp"
 
 namespace {
 
@@ -60,7 +60,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
       check(next < tokens.size(), "Conditionals::handle went past the end");
       i = next == i ? i + 1 : next;
     }
-  } catch (const ssao_io::Error&) {
+  } catch (const ssao_tools::Error&) {
     // An unterminated string or comment.
   }
 
@@ -73,13 +73,13 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   SceneScan scan;
   try {
     scan = scan_scene(path, settings);
-  } catch (const ssao_io::Error&) {
+  } catch (const ssao_tools::Error&) {
     return 0;
   }
   CameraReading reading;
   try {
     reading = read_camera(scan, CameraOverrides{}, kWidth, kHeight);
-  } catch (const ssao_io::Error&) {
+  } catch (const ssao_tools::Error&) {
     return 0;
   }
   const ResolvedCamera& camera = reading.camera;
@@ -92,9 +92,9 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     for (int x : {0, kWidth - 1}) (void)camera.radial_factor(x, y, kWidth, kHeight);
   }
   try {
-    ssao_io::Job job;
+    ssao::api::Job job;
     camera.apply_to_job(job, kWidth, kHeight);
-  } catch (const ssao_io::Error&) {
+  } catch (const ssao::api::Error&) {
     // A camera libssao cannot model (e.g. a lens beyond its range): povray-ssao says so.
   }
   return 0;

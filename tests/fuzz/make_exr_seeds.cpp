@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: MIT
-// Writes the seed corpus of fuzz_exr with the project's own writer (ssao_io::write_exr): small
+// Writes the seed corpus of fuzz_exr with the project's own writer (ssao_tools::write_exr): small
 // EXR files as Blender writes them (a multilayer file's <layer>.<pass>.<channel> names) and as
 // other tools do (Z, R, G, B, A), a few hundred bytes to a few KB each, so no binary is kept in
 // the repository. Usage: make_exr_seeds FOLDER
@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-#include "io/image_io.h"
+#include "tools/image_io.h"
 
 namespace {
 
@@ -32,7 +32,7 @@ void write_scene(const std::string& path, int width, int height,
       }
     }
   }
-  ssao_io::write_exr(path, width, height, names, pixels);
+  ssao_tools::write_exr(path, width, height, names, pixels);
 }
 
 }  // namespace
@@ -50,7 +50,7 @@ int main(int argc, char** argv) {
                  "ViewLayer.Normal.Y", "ViewLayer.Normal.Z"});
     write_scene(folder + "/flat_names.exr", 5, 3, {"R", "G", "B", "A", "Z"});
     write_scene(folder + "/depth_only.exr", 1, 1, {"Depth.Z"});
-  } catch (const ssao_io::Error& e) {
+  } catch (const ssao_tools::Error& e) {
     std::fprintf(stderr, "make_exr_seeds: %s\n", e.what());
     return 1;
   }

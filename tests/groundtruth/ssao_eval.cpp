@@ -35,11 +35,11 @@
 #include <vector>
 
 #include "camera.h"  // core/src (through ssao_reference): the camera model of the references
-#include "io/blender_passes.h"
-#include "io/camera_json.h"
-#include "io/image_io.h"
-#include "io/job.h"
 #include "reference_ao.h"
+#include "ssao/ssao.hpp"
+#include "tools/blender_passes.h"
+#include "tools/camera_json.h"
+#include "tools/image_io.h"
 
 namespace {
 
@@ -312,7 +312,7 @@ struct Scene {
   std::string name;  // file name without folder and extension
   std::string path;
   int width = 0, height = 0;
-  ssao_io::Camera camera;
+  ssao_tools::Camera camera;
   std::vector<float> depth;         // planar, 1 channel
   std::vector<float> world_normal;  // 3 channels or empty
   std::vector<float> truth;         // the AO pass
@@ -327,27 +327,27 @@ struct Scene {
 
 // Reads --layers FILE into the scene: a data window grown by the same band on every side.
 void load_layers(const Options& o, Scene& s) {
-  ssao_io::Image image = ssao_io::read_image(o.layers_file, ssao_io::Overscan::read);
+  ssao_tools::Image image = ssao_tools::read_image(o.layers_file, ssao_tools::Overscan::read);
   const int band = image.frame_x;
   if (image.frame_width != s.width || image.frame_height != s.height || image.frame_y != band ||
       image.width != s.width + 2 * band || image.height != s.height + 2 * band) {
-    throw ssao_io::Error("'" + o.layers_file + "' is not the scene's frame (" +
-                         std::to_string(s.width) + "x" + std::to_string(s.height) +
-                         ") with the same guard band on every side");
+    throw ssao_tools::Error("'" + o.layers_file + "' is not the scene's frame (" +
+                            std::to_string(s.width) + "x" + std::to_string(s.height) +
+                            ") with the same guard band on every side");
   }
-  ssao_io::PassOverrides overrides;
+  ssao_tools::PassOverrides overrides;
   overrides.layer = o.layer;
-  const ssao_io::PassChannels passes =
-      ssao_io::detect_passes(image.channel_names, overrides, o.layers_file);
+  const ssao_tools::PassChannels passes =
+      ssao_tools::detect_passes(image.channel_names, overrides, o.layers_file);
   const auto channel = [&](const std::string& name) {
-    return ssao_io::extract_named_channels(image, {name}, o.layers_file);
+    return ssao_tools::extract_named_channels(image, {name}, o.layers_file);
   };
   s.band = band;
   s.band_depth = channel(passes.depth);
   if (passes.normal.size() == 3) {
-    s.band_normal = ssao_io::extract_named_channels(image, passes.normal, o.layers_file);
+    s.band_normal = ssao_tools::extract_named_channels(image, passes.normal, o.layers_file);
   }
-  for (const ssao_io::DepthLayerChannels& layer : passes.depth_layers) {
+  for (const ssao_tools::DepthLayerChannels& layer : passes.depth_layers) {
     s.layer_depth.push_back(channel(layer.depth));
     s.layer_facing.push_back(layer.facing.empty() ? std::vector<float>() : channel(layer.facing));
   }
@@ -358,33 +358,33 @@ Scene load_scene(const Options& o) {
   s.path = o.scene;
   s.name = std::filesystem::path(o.scene).stem().string();
   // The camera first: it is small and a mistake there is cheaper to find.
-  s.camera = ssao_io::read_camera_json(o.camera);
+  s.camera = ssao_tools::read_camera_json(o.camera);
   for (const std::string& key : s.camera.unknown_keys) {
     std::fprintf(stderr, "%s: warning: camera file '%s': unknown key '%s' ignored\n", kProgram,
                  o.camera.c_str(), key.c_str());
   }
 
-  ssao_io::Image image = ssao_io::read_image(o.scene);
-  ssao_io::PassOverrides overrides;
+  ssao_tools::Image image = ssao_tools::read_image(o.scene);
+  ssao_tools::PassOverrides overrides;
   overrides.layer = o.layer;
   overrides.no_normals = o.no_normals;
-  const ssao_io::PassChannels passes =
-      ssao_io::detect_passes(image.channel_names, overrides, o.scene);
+  const ssao_tools::PassChannels passes =
+      ssao_tools::detect_passes(image.channel_names, overrides, o.scene);
   const std::string ao_channel = passes.layer.empty() ? "AO.R" : passes.layer + ".AO.R";
   const int ao_index = image.find_channel(ao_channel);
   if (ao_index < 0) {
-    throw ssao_io::Error("'" + o.scene + "' has no AO pass (no channel '" + ao_channel +
-                         "'): render it with the Ambient Occlusion pass enabled; its channels "
-                         "are: " +
-                         ssao_io::join_names(image.channel_names));
+    throw ssao_tools::Error("'" + o.scene + "' has no AO pass (no channel '" + ao_channel +
+                            "'): render it with the Ambient Occlusion pass enabled; its channels "
+                            "are: " +
+                            ssao_tools::join_names(image.channel_names));
   }
   s.width = image.width;
   s.height = image.height;
-  s.depth = ssao_io::extract_named_channels(image, {passes.depth}, o.scene);
+  s.depth = ssao_tools::extract_named_channels(image, {passes.depth}, o.scene);
   if (!passes.normal.empty()) {
-    s.world_normal = ssao_io::extract_named_channels(image, passes.normal, o.scene);
+    s.world_normal = ssao_tools::extract_named_channels(image, passes.normal, o.scene);
   }
-  s.truth = ssao_io::extract_channels(image, {ao_index});
+  s.truth = ssao_tools::extract_channels(image, {ao_index});
 
   const double limit = 0.9 * s.camera.clip_end;
   s.mask.assign(s.depth.size(), 0);
@@ -397,9 +397,9 @@ Scene load_scene(const Options& o) {
     }
   }
   if (s.scored == 0) {
-    throw ssao_io::Error("'" + o.scene +
-                         "' has no pixel to score (none with a finite depth in (0, " +
-                         std::to_string(limit) + "), 0.9 x the camera's clip_end)");
+    throw ssao_tools::Error("'" + o.scene +
+                            "' has no pixel to score (none with a finite depth in (0, " +
+                            std::to_string(limit) + "), 0.9 x the camera's clip_end)");
   }
   if (!o.layers_file.empty()) load_layers(o, s);
   return s;
@@ -415,8 +415,8 @@ std::string format_number(double value) {
 }
 
 // The value of a core parameter as set by --set, typed after the parameter table.
-void set_core_param(ssao_io::Job& job, const std::vector<ssao_param_desc>& table, const Setting& s,
-                    const std::string& flag) {
+void set_core_param(ssao::api::Job& job, const std::vector<ssao_param_desc>& table,
+                    const Setting& s, const std::string& flag) {
   const auto it = std::find_if(table.begin(), table.end(),
                                [&](const ssao_param_desc& d) { return s.name == d.name; });
   const std::string where = flag + " " + s.name + "=" + s.value;
@@ -443,7 +443,7 @@ void set_core_param(ssao_io::Job& job, const std::vector<ssao_param_desc>& table
         job.set(s.name, parse_double_list(s.value, where));
         break;
     }
-  } catch (const ssao_io::CoreError&) {
+  } catch (const ssao::api::Error&) {
     throw UsageError(where + ": " + ssao_last_error());
   }
 }
@@ -541,15 +541,15 @@ Method make_image_method(const std::vector<Setting>& settings, const std::string
   m.settings = "path=" + path;
   if (scene == nullptr) return m;
 
-  const ssao_io::Image image = ssao_io::read_image(path);
+  const ssao_tools::Image image = ssao_tools::read_image(path);
   if (image.width != scene->width || image.height != scene->height) {
-    throw ssao_io::Error("'" + path + "' is " + std::to_string(image.width) + "x" +
-                         std::to_string(image.height) + ", the scene " +
-                         std::to_string(scene->width) + "x" + std::to_string(scene->height));
+    throw ssao_tools::Error("'" + path + "' is " + std::to_string(image.width) + "x" +
+                            std::to_string(image.height) + ", the scene " +
+                            std::to_string(scene->width) + "x" + std::to_string(scene->height));
   }
   int index = -1;
   if (!channel.empty()) {
-    index = ssao_io::require_channel(image, channel, path);
+    index = ssao_tools::require_channel(image, channel, path);
   } else {
     // The AO: a channel "AO", "AO.R" or "<layer>.AO.R"; with several, channel= must choose.
     std::vector<int> found;
@@ -561,14 +561,14 @@ Method make_image_method(const std::vector<Setting>& settings, const std::string
       }
     }
     if (found.size() != 1) {
-      throw ssao_io::Error("'" + path + "' has " + (found.empty() ? "no" : "more than one") +
-                           " AO channel (AO, AO.R or <layer>.AO.R): choose one with "
-                           "channel=NAME; its channels: " +
-                           ssao_io::join_names(image.channel_names));
+      throw ssao_tools::Error("'" + path + "' has " + (found.empty() ? "no" : "more than one") +
+                              " AO channel (AO, AO.R or <layer>.AO.R): choose one with "
+                              "channel=NAME; its channels: " +
+                              ssao_tools::join_names(image.channel_names));
     }
     index = found.front();
   }
-  *m.ao = ssao_io::extract_channels(image, {index});
+  *m.ao = ssao_tools::extract_channels(image, {index});
   if (!region.empty()) {
     const double w = scene->width, h = scene->height;
     m.window.x0 = static_cast<int>(std::ceil(region[0] * w)) + 1;
@@ -620,7 +620,7 @@ ReferenceSettings parse_reference_settings(const std::string& method,
 
 // Everything the ssao method keeps between runs.
 struct CoreState {
-  ssao_io::Job job;
+  ssao::api::Job job;
   std::vector<float> depth, normal;
   std::vector<std::vector<float>> layer_depth, layer_facing;
 };
@@ -658,13 +658,13 @@ Method make_method(const std::string& name, const std::vector<Setting>& settings
   Method m;
   m.name = name;
   if (name == "ssao") {
-    const std::vector<ssao_param_desc> table = ssao_io::param_table();
+    const std::vector<ssao_param_desc> table = ssao::api::param_table();
     auto state = std::make_shared<CoreState>();
-    ssao_io::Job& job = state->job;
-    if (scene != nullptr) ssao_io::apply_camera(job.get(), scene->camera, scene->path);
+    ssao::api::Job& job = state->job;
+    if (scene != nullptr) ssao_tools::apply_camera(job.get(), scene->camera, scene->path);
     try {
       job.set("radius", radius);
-    } catch (const ssao_io::CoreError&) {
+    } catch (const ssao::api::Error&) {
       throw UsageError(std::string("--radius: ") + ssao_last_error());
     }
     // layers=N and band=G (with --layers) are the evaluation's; the rest are core parameters,
@@ -827,7 +827,7 @@ Score score(const Scene& s, const Method& m) {
   sc.rmse_interior = sc.interior_pixels > 0
                          ? std::sqrt(interior_sq / static_cast<double>(sc.interior_pixels))
                          : std::numeric_limits<double>::quiet_NaN();
-  if (sc.pixels == 0) throw ssao_io::Error(m.name + " " + m.settings + ": no pixel to score");
+  if (sc.pixels == 0) throw ssao_tools::Error(m.name + " " + m.settings + ": no pixel to score");
   const double n = static_cast<double>(sc.pixels);
   sc.rmse = std::sqrt(sum_sq / n);
   sc.mean_error = sum / n;
@@ -866,7 +866,8 @@ void check_output(const Options& o) {
   if (folder.empty()) folder = ".";
   std::error_code ec;
   if (!std::filesystem::is_directory(folder, ec)) {
-    throw ssao_io::Error("cannot write '" + o.write_ao + "': no folder '" + folder.string() + "'");
+    throw ssao_tools::Error("cannot write '" + o.write_ao + "': no folder '" + folder.string() +
+                            "'");
   }
 }
 
@@ -892,7 +893,7 @@ int run(const Options& o) {
     scores.push_back(report(scene, o, methods[i], times[i]));
   }
   if (!o.write_ao.empty()) {
-    ssao_io::write_exr(o.write_ao, scene.width, scene.height, {"AO"}, *methods.front().ao);
+    ssao_tools::write_exr(o.write_ao, scene.width, scene.height, {"AO"}, *methods.front().ao);
   }
 
   int status = 0;

@@ -1,14 +1,14 @@
 // SPDX-License-Identifier: MIT
-// Frame specifications and file name patterns of image sequences (core/io/frames.h).
+// Frame specifications and file name patterns of image sequences (core/tools/frames.h).
 #include <gtest/gtest.h>
 
 #include <string>
 #include <vector>
 
-#include "io/frames.h"
+#include "tools/frames.h"
 
-using ssao_io::FramePattern;
-using ssao_io::parse_frames;
+using ssao_tools::FramePattern;
+using ssao_tools::parse_frames;
 
 namespace {
 
@@ -16,7 +16,7 @@ namespace {
 std::string frames_error(const std::string& spec) {
   try {
     parse_frames(spec);
-  } catch (const ssao_io::Error& e) {
+  } catch (const ssao_tools::Error& e) {
     return e.what();
   }
   return "";
@@ -66,12 +66,12 @@ TEST(Frames, PatternsPadTheFrameNumber) {
   EXPECT_EQ(FramePattern("shots@v2/#1/render.##.exr").path(3), "shots@v2/#1/render.03.exr");
   EXPECT_EQ(FramePattern::literal("cam@1080.json").path(3), "cam@1080.json");
   EXPECT_FALSE(FramePattern::literal("r.####.exr").has_frame());
-  EXPECT_THROW(FramePattern("a.##.b.##.exr"), ssao_io::Error);
-  EXPECT_THROW(FramePattern("a.%04d.#.exr"), ssao_io::Error);
+  EXPECT_THROW(FramePattern("a.##.b.##.exr"), ssao_tools::Error);
+  EXPECT_THROW(FramePattern("a.%04d.#.exr"), ssao_tools::Error);
 }
 
 TEST(Frames, FormatIsReadBackAsTheSameFrames) {
-  using ssao_io::format_frames;
+  using ssao_tools::format_frames;
   EXPECT_EQ(format_frames({1001, 1002, 1003}), "1001-1003");
   EXPECT_EQ(format_frames({1, 5, 9, 10, 11, 12}), "1-9x4,10-12");
   EXPECT_EQ(format_frames({7, 8}), "7-8");
@@ -104,8 +104,8 @@ TEST(Frames, FormatIsReadBackAsTheSameFrames) {
 }
 
 TEST(Frames, ChunksCoverEveryFrameOnceInOrder) {
-  using ssao_io::chunk_count;
-  using ssao_io::chunk_frames;
+  using ssao_tools::chunk_count;
+  using ssao_tools::chunk_frames;
   // 11 frames in chunks of 4: the last chunk is short (the Slurm trap: an array 1001-1011:4
   // reports 1009 as its last index, and frames 1010-1011 must not be lost).
   const std::vector<int> frames = parse_frames("1001-1011");
@@ -127,7 +127,7 @@ TEST(Frames, ChunksCoverEveryFrameOnceInOrder) {
   try {
     chunk_frames(frames, 4, 3);
     FAIL() << "chunk 3 of 3 was accepted";
-  } catch (const ssao_io::Error& e) {
+  } catch (const ssao_tools::Error& e) {
     EXPECT_NE(std::string(e.what()).find("make 3 chunks (0-2)"), std::string::npos) << e.what();
   }
 }

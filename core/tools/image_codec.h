@@ -6,9 +6,9 @@
 #include <string>
 #include <vector>
 
-#include "io/image_io.h"
+#include "tools/image_io.h"
 
-namespace ssao_io {
+namespace ssao_tools {
 
 struct ImageCodec {
   bool (*read)(const std::string& path, Image& image, std::string& error);
@@ -20,7 +20,7 @@ struct ImageCodec {
                         const std::vector<float>& pixels, std::string& error);
 };
 
-}  // namespace ssao_io
+}  // namespace ssao_tools
 
 // Exported by the module (looked up with dlsym).
-extern "C" const ssao_io::ImageCodec* ssao_io_image_codec();
+extern "C" const ssao_tools::ImageCodec* ssao_tools_image_codec();

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: MIT
-#include "io/camera_json.h"
+#include "tools/camera_json.h"
 
 #include <algorithm>
 #include <cmath>
@@ -9,9 +9,9 @@
 #include <sstream>
 #include <utility>
 
-#include "io/job.h"
+#include "ssao/ssao.hpp"
 
-namespace ssao_io {
+namespace ssao_tools {
 namespace {
 
 using Json = nlohmann::json;
@@ -222,10 +222,10 @@ bool is_camera_param(const std::string& name) {
 void apply_camera(ssao_job job, const Camera& camera, const std::string& source) {
   const std::string where = "camera file '" + source + "': ";
   auto set_float = [&](const char* name, double value) {
-    check_status(ssao_job_set_float(job, name, value), where + name);
+    ssao::api::check_status(ssao_job_set_float(job, name, value), where + name);
   };
   auto set_string = [&](const char* name, const std::string& value) {
-    check_status(ssao_job_set_string(job, name, value.c_str()), where + name);
+    ssao::api::check_status(ssao_job_set_string(job, name, value.c_str()), where + name);
   };
   set_string("camera_type", camera.type);
   set_float("lens", camera.lens);
@@ -239,9 +239,9 @@ void apply_camera(ssao_job job, const Camera& camera, const std::string& source)
   set_float("clip_end", camera.clip_end);
   set_float("pixel_aspect_x", camera.pixel_aspect_x);
   set_float("pixel_aspect_y", camera.pixel_aspect_y);
-  check_status(ssao_job_set_floats(job, "camera_to_world", camera.matrix_world.data(),
-                                   camera.matrix_world.size()),
-               where + "matrix_world");
+  ssao::api::check_status(ssao_job_set_floats(job, "camera_to_world", camera.matrix_world.data(),
+                                              camera.matrix_world.size()),
+                          where + "matrix_world");
 }
 
-}  // namespace ssao_io
+}  // namespace ssao_tools

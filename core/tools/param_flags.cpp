@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: MIT
-#include "io/param_flags.h"
+#include "tools/param_flags.h"
 
 #include <algorithm>
 #include <cctype>
@@ -9,7 +9,7 @@
 #include <cstdio>
 #include <cstdlib>
 
-namespace ssao_io {
+namespace ssao_tools {
 namespace {
 
 constexpr size_t kHelpColumn = 30;
@@ -149,7 +149,7 @@ ParamSetting parse_param(const ssao_param_desc& desc, const std::string& flag,
   return setting;
 }
 
-void apply_params(Job& job, const std::vector<ParamSetting>& settings) {
+void apply_params(ssao::api::Job& job, const std::vector<ParamSetting>& settings) {
   for (const ParamSetting& setting : settings) {
     try {
       switch (setting.type) {
@@ -166,7 +166,7 @@ void apply_params(Job& job, const std::vector<ParamSetting>& settings) {
           job.set(setting.name, setting.float_values);
           break;
       }
-    } catch (const CoreError&) {
+    } catch (const ssao::api::Error&) {
       throw UsageError(setting.flag + " " + setting.text + ": " + ssao_last_error());
     }
   }
@@ -238,4 +238,4 @@ std::string param_facts(const ssao_param_desc& desc) {
   return facts;
 }
 
-}  // namespace ssao_io
+}  // namespace ssao_tools

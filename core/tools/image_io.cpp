@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: MIT
-#include "io/image_io.h"
+#include "tools/image_io.h"
 
 #include <dlfcn.h>
 
@@ -10,11 +10,11 @@
 #include <filesystem>
 #include <mutex>
 
-#include "io/image_codec.h"
+#include "tools/image_codec.h"
 
 namespace fs = std::filesystem;
 
-namespace ssao_io {
+namespace ssao_tools {
 namespace {
 
 std::string quoted(const std::string& path) { return "'" + path + "'"; }
@@ -42,7 +42,7 @@ const ImageCodec& codec() {
     }
     if (handle == nullptr) return;
     using Entry = const ImageCodec* (*)();
-    const auto entry = reinterpret_cast<Entry>(::dlsym(handle, "ssao_io_image_codec"));
+    const auto entry = reinterpret_cast<Entry>(::dlsym(handle, "ssao_tools_image_codec"));
     if (entry == nullptr) {
       problem = std::string("no entry point: ") + ::dlerror();
       return;
@@ -181,4 +181,4 @@ bool is_preview_path(const std::string& path) {
          extension == ".tif" || extension == ".tiff";
 }
 
-}  // namespace ssao_io
+}  // namespace ssao_tools

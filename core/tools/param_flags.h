@@ -11,10 +11,10 @@
 #include <string>
 #include <vector>
 
-#include "io/job.h"
 #include "ssao/ssao.h"
+#include "ssao/ssao.hpp"
 
-namespace ssao_io {
+namespace ssao_tools {
 
 // A wrong command line: front ends report it with a hint to --help and exit status 2.
 class UsageError : public std::runtime_error {
@@ -49,7 +49,7 @@ ParamSetting parse_param(const ssao_param_desc& desc, const std::string& flag,
 
 // Sets every setting on `job`, in order. A value the core rejects (out of range) is a
 // UsageError naming the flag and the core's message.
-void apply_params(Job& job, const std::vector<ParamSetting>& settings);
+void apply_params(ssao::api::Job& job, const std::vector<ParamSetting>& settings);
 
 // Strict number parsing for flags: the whole text must be the number. UsageError otherwise.
 int parse_int(const std::string& flag, const std::string& text);
@@ -165,4 +165,4 @@ void parse_option(int argc, const char* const* argv, int& i,
   }
 }
 
-}  // namespace ssao_io
+}  // namespace ssao_tools

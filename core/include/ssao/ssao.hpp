@@ -1,35 +1,37 @@
-// SPDX-License-Identifier: MIT
-// A small RAII wrapper over the C API for front ends: ssao_io::Job owns an ssao_job, and every
-// call throws ssao_io::Error carrying ssao_last_error() when the core does not return SSAO_OK.
+// A small RAII wrapper over the C API for front ends: ssao_tools::Job owns an ssao_job, and every
+// call throws ssao_tools::Error carrying ssao_last_error() when the core does not return SSAO_OK.
 // Header-only: it uses nothing but ssao/ssao.h.
-#pragma once
+#ifndef SSAO_SSAO_HPP
+#define SSAO_SSAO_HPP
 
 #include <cstddef>
+#include <stdexcept>
 #include <string>
 #include <utility>
 #include <vector>
 
-#include "io/error.h"
 #include "ssao/ssao.h"
 
-namespace ssao_io {
+namespace ssao {
+namespace api {
 
 // The error raised for a non-OK status: its status code is kept for callers that care.
-class CoreError : public Error {
+class Error : public std::runtime_error {
  public:
-  CoreError(ssao_status status, const std::string& message) : Error(message), status_(status) {}
+  Error(ssao_status status, const std::string& message)
+      : std::runtime_error(message), status_(status) {}
   ssao_status status() const { return status_; }
 
  private:
   ssao_status status_;
 };
 
-// Throws CoreError("<what>: <ssao_last_error()>") unless status is SSAO_OK.
+// Throws Error("<what>: <ssao_last_error()>") unless status is SSAO_OK.
 inline void check_status(ssao_status status, const std::string& what) {
   if (status == SSAO_OK) return;
   std::string detail = ssao_last_error();
   if (detail.empty()) detail = ssao_status_string(status);
-  throw CoreError(status, what.empty() ? detail : what + ": " + detail);
+  throw Error(status, what.empty() ? detail : what + ": " + detail);
 }
 
 // Every parameter of the core, in table order.
@@ -129,4 +131,7 @@ class Job {
   ssao_job job_ = nullptr;
 };
 
-}  // namespace ssao_io
+}  // namespace api
+}  // namespace ssao
+
+#endif /* SSAO_SSAO_HPP */

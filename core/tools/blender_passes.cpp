@@ -1,11 +1,11 @@
 // SPDX-License-Identifier: MIT
-#include "io/blender_passes.h"
+#include "tools/blender_passes.h"
 
 #include <algorithm>
 
-#include "io/image_io.h"
+#include "tools/image_io.h"
 
-namespace ssao_io {
+namespace ssao_tools {
 namespace {
 
 const char* const kDepthSuffix = ".Depth.Z";
@@ -173,4 +173,4 @@ PassChannels detect_passes(const std::vector<std::string>& channels, const PassO
   return out;
 }
 
-}  // namespace ssao_io
+}  // namespace ssao_tools

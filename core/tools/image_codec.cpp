@@ -1,9 +1,9 @@
 // SPDX-License-Identifier: MIT
-// Image files through OpenImageIO, built as a module (libssao_image_codec.so) that ssao_io loads
+// Image files through OpenImageIO, built as a module (libssao_image_codec.so) that ssao_tools loads
 // on first use (image_io.cpp): OpenImageIO brings about 260 shared libraries, whose loading
 // costs 0.2 s at start-up. Loaded later, that time overlaps other work (povray-ssao starts
 // POV-Ray first). Errors cross the module boundary as messages, not exceptions.
-#include "io/image_codec.h"
+#include "tools/image_codec.h"
 
 #include <OpenImageIO/imageio.h>
 #include <fcntl.h>
@@ -27,7 +27,7 @@
 
 namespace fs = std::filesystem;
 
-namespace ssao_io {
+namespace ssao_tools {
 namespace {
 
 std::string quoted(const std::string& path) { return "'" + path + "'"; }
@@ -379,8 +379,9 @@ const ImageCodec kCodec = {
 };
 
 }  // namespace
-}  // namespace ssao_io
+}  // namespace ssao_tools
 
-extern "C" __attribute__((visibility("default"))) const ssao_io::ImageCodec* ssao_io_image_codec() {
-  return &ssao_io::kCodec;
+extern "C" __attribute__((visibility("default"))) const ssao_tools::ImageCodec*
+ssao_tools_image_codec() {
+  return &ssao_tools::kCodec;
 }

@@ -21,10 +21,10 @@
 #include <string>
 #include <vector>
 
-#include "io/error.h"
 #include "ssao/ssao.h"
+#include "tools/error.h"
 
-namespace ssao_io {
+namespace ssao_tools {
 
 struct Camera {
   std::string type = "PERSP";       // "PERSP" | "ORTHO"
@@ -67,4 +67,4 @@ bool is_camera_param(const std::string& name);
 // messages. Throws Error with ssao_last_error() when the core rejects a value.
 void apply_camera(ssao_job job, const Camera& camera, const std::string& source);
 
-}  // namespace ssao_io
+}  // namespace ssao_tools

@@ -1,14 +1,16 @@
 // SPDX-License-Identifier: MIT
-// Progress on stderr for ssao_job_set_progress, and Ctrl-C as cancellation.
+// Progress of a library run on stderr, and Ctrl-C as cancellation (tools/interrupt.h).
 #pragma once
 
 #include "ssao/ssao.h"
+#include "tools/interrupt.h"
 
-namespace ssao_cli {
+namespace ssao_tools {
 
-// On a terminal: "ssao: 42%" rewritten in place. Otherwise: one line as each of 25, 50, 75 and
-// 100% is reached. Nothing when quiet. SIGINT and SIGTERM, while an instance exists, make the
-// callback cancel the run (SSAO_ERROR_CANCELLED).
+// The percentage of a library run on stderr (ssao_job_set_progress). On a terminal: "ssao: 42%"
+// rewritten in place. Otherwise: one line as each of 25, 50, 75 and 100% is reached. Nothing when
+// quiet. SIGINT and SIGTERM, while an instance exists, make the callback cancel the run
+// (SSAO_ERROR_CANCELLED).
 class ProgressReporter {
  public:
   explicit ProgressReporter(bool quiet);
@@ -23,15 +25,16 @@ class ProgressReporter {
   void finish();
 
   // True once SIGINT or SIGTERM was received.
-  static bool interrupted();
+  static bool interrupted() { return InterruptGuard::interrupted(); }
 
  private:
   void report(double fraction);
 
+  InterruptGuard interrupt_guard_;
   bool quiet_;
   bool terminal_;
   int last_percent_ = -1;
   bool line_open_ = false;
 };
 
-}  // namespace ssao_cli
+}  // namespace ssao_tools

@@ -11,9 +11,9 @@
 #include <string>
 #include <vector>
 
-#include "io/error.h"
+#include "tools/error.h"
 
-namespace ssao_io {
+namespace ssao_tools {
 
 constexpr size_t kMaxFrames = 1000000;
 
@@ -50,4 +50,4 @@ class FramePattern {
   int width_ = -1;  // digits of padding; -1: no placeholder
 };
 
-}  // namespace ssao_io
+}  // namespace ssao_tools

@@ -9,9 +9,9 @@
 #include <string>
 #include <vector>
 
-#include "io/error.h"
+#include "tools/error.h"
 
-namespace ssao_io {
+namespace ssao_tools {
 
 // A whole image in memory: pixel (x, y), y = 0 the TOP row, channel c is
 // pixels[(y * width + x) * channels() + c].
@@ -98,4 +98,4 @@ void preload_image_io();
 // Comma-separated list of the names, for messages: "R, G, B".
 std::string join_names(const std::vector<std::string>& names, const char* separator = ", ");
 
-}  // namespace ssao_io
+}  // namespace ssao_tools

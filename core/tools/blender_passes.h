@@ -21,9 +21,9 @@
 #include <string>
 #include <vector>
 
-#include "io/error.h"
+#include "tools/error.h"
 
-namespace ssao_io {
+namespace ssao_tools {
 
 // Extra depth layers the library takes: the 2nd to the 5th hit ("depth2" ... "depth5").
 constexpr size_t kMaxDepthLayers = 4;
@@ -60,4 +60,4 @@ std::vector<std::string> layers_with_depth(const std::vector<std::string>& chann
 PassChannels detect_passes(const std::vector<std::string>& channels, const PassOverrides& overrides,
                            const std::string& file);
 
-}  // namespace ssao_io
+}  // namespace ssao_tools

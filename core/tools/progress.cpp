@@ -1,39 +1,18 @@
 // SPDX-License-Identifier: MIT
-#include "progress.h"
+#include "tools/progress.h"
 
 #include <unistd.h>
 
 #include <algorithm>
 #include <cmath>
-#include <csignal>
 #include <cstdio>
 
-namespace ssao_cli {
-namespace {
-
-volatile std::sig_atomic_t g_interrupted = 0;
-
-void on_interrupt(int) { g_interrupted = 1; }
-
-using Handler = void (*)(int);
-Handler g_previous_sigint = SIG_DFL;
-Handler g_previous_sigterm = SIG_DFL;
-
-}  // namespace
+namespace ssao_tools {
 
 ProgressReporter::ProgressReporter(bool quiet)
-    : quiet_(quiet), terminal_(::isatty(STDERR_FILENO) == 1) {
-  g_previous_sigint = std::signal(SIGINT, on_interrupt);
-  g_previous_sigterm = std::signal(SIGTERM, on_interrupt);
-}
+    : quiet_(quiet), terminal_(::isatty(STDERR_FILENO) == 1) {}
 
-ProgressReporter::~ProgressReporter() {
-  finish();
-  std::signal(SIGINT, g_previous_sigint == SIG_ERR ? SIG_DFL : g_previous_sigint);
-  std::signal(SIGTERM, g_previous_sigterm == SIG_ERR ? SIG_DFL : g_previous_sigterm);
-}
-
-bool ProgressReporter::interrupted() { return g_interrupted != 0; }
+ProgressReporter::~ProgressReporter() { finish(); }
 
 int ProgressReporter::callback(void* user, double fraction) {
   static_cast<ProgressReporter*>(user)->report(fraction);
@@ -67,4 +46,4 @@ void ProgressReporter::finish() {
   }
 }
 
-}  // namespace ssao_cli
+}  // namespace ssao_tools

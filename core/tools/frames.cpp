@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: MIT
-#include "io/frames.h"
+#include "tools/frames.h"
 
 #include <algorithm>
 #include <cctype>
@@ -8,7 +8,7 @@
 #include <cstdlib>
 #include <set>
 
-namespace ssao_io {
+namespace ssao_tools {
 namespace {
 
 std::string quoted(const std::string& text) { return "'" + text + "'"; }
@@ -164,4 +164,4 @@ std::string FramePattern::path(int frame) const {
   return prefix_ + (frame < 0 ? "-" : "") + digits + suffix_;
 }
 
-}  // namespace ssao_io
+}  // namespace ssao_tools
