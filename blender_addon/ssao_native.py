@@ -108,6 +108,9 @@ def _declare(lib):
         sig("ssao_job_set_output_window", c_int, job, c_int, c_int, c_int)
     sig("ssao_job_set_progress", c_int, job, _PROGRESS_FN, ctypes.c_void_p)
     sig("ssao_job_run", c_int, job)
+    if hasattr(lib, "ssao_job_last_run"):  # since 0.1 after issue 23
+        sig("ssao_job_last_run", c_int, job, ctypes.POINTER(ctypes.c_size_t),
+            ctypes.POINTER(c_double))
 
 
 def parameters(lib):
@@ -218,3 +221,10 @@ class Job:
         finally:
             if callback is not None:
                 self._lib.ssao_job_set_progress(self._job, _PROGRESS_FN(), None)
+
+    def last_run(self):
+        """(geometry_pixels, mean_ao) of the last successful run over the frame: the pixels the
+        library's background rule took as geometry and their mean AO (ssao_job_last_run)."""
+        geometry, mean = ctypes.c_size_t(), ctypes.c_double()
+        self._lib.ssao_job_last_run(self._job, ctypes.byref(geometry), ctypes.byref(mean))
+        return geometry.value, mean.value

@@ -182,4 +182,15 @@ SSAO_API ssao_status ssao_job_run(ssao_job job) {
   return guarded([&] { checked(job).run(); });
 }
 
+SSAO_API ssao_status ssao_job_last_run(ssao_job job, size_t* geometry_pixels, double* mean_ao) {
+  return guarded([&] {
+    if (geometry_pixels == nullptr || mean_ao == nullptr) {
+      ssao::throw_invalid_argument("output pointer is NULL");
+    }
+    const ssao::Job::RunStats stats = checked(job).last_run();
+    *geometry_pixels = stats.geometry_pixels;
+    *mean_ao = stats.mean_ao;
+  });
+}
+
 }  // extern "C"

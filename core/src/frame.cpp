@@ -87,14 +87,13 @@ void Frame::build_depth(const FrameInputs& in, TilePool& pool, Progress& progres
 }
 
 void Frame::fill_depth(const FrameInputs& in, TilePool& pool, Progress& progress) {
-  // A depth at or beyond this is background (so are NaN, infinity and depths <= 0).
-  const float limit =
-      in.clip_end > 0.0f ? std::min(in.background_depth, in.clip_end) : in.background_depth;
+  const float limit = in.background_limit;
   pool.for_each_tile(width_, height_, progress, [&](const Tile& t) {
     for (int y = t.y0; y < t.y1; ++y) {
       float* row = depth_.data() + index(t.x0, y);
       in.depth.read_channel0(t.x0, y, t.x1 - t.x0, row);
-      depth_row(row, t.x0, t.x1 - t.x0, float(y) + 0.5f, in.radial_depth, limit);
+      planar_depth_row(camera_.intrinsics(), row, t.x0, t.x1 - t.x0, float(y) + 0.5f,
+                       in.radial_depth, limit);
       for (int k = 0; k < extra_layers_; ++k) layer_row(in, k, t.x0, t.x1 - t.x0, y, limit);
     }
   });
@@ -187,7 +186,7 @@ void Frame::layer_row(const FrameInputs& in, int k, int x0, int count, int y, fl
   float* row = layers_.data() + size_t(k) * pixel_count() + index(x0, y);
   const float* before = k == 0 ? depth_.data() + index(x0, y) : row - pixel_count();
   in.layers[k].read_channel0(x0, y, count, row);
-  depth_row(row, x0, count, float(y) + 0.5f, in.radial_depth, limit);
+  planar_depth_row(camera_.intrinsics(), row, x0, count, float(y) + 0.5f, in.radial_depth, limit);
   const bool alternating_back = k % 2 == 0;
   for (int i = 0; i < count; ++i) {
     const float previous = std::fabs(before[i]);
@@ -286,9 +285,13 @@ void Frame::downsample(const Frame& full, const FrameInputs& in, TilePool& pool,
 // Planar depth from the caller's values in place: radial ones divided by the ray length per unit
 // of planar depth, background marked. A loop without calls or branches, which the compiler
 // vectorises (NaN fails every comparison, so it is background).
-SSAO_VECTORIZE void Frame::depth_row(float* __restrict depth, int x0, int count, float v,
-                                     bool radial, float limit) const {
-  const CameraIntrinsics cam = camera_.intrinsics();
+float background_limit(double background_depth, double clip_end) {
+  const double limit = clip_end > 0.0 ? std::min(background_depth, clip_end) : background_depth;
+  return static_cast<float>(std::min(limit, double(std::numeric_limits<float>::max())));
+}
+
+SSAO_VECTORIZE void Frame::planar_depth_row(const CameraIntrinsics& cam, float* __restrict depth,
+                                            int x0, int count, float v, bool radial, float limit) {
   const float perspective_radial = radial && !cam.orthographic ? 1.0f : 0.0f;
   const float y = (cam.center_v - v) * cam.scale_v;
   for (int i = 0; i < count; ++i) {

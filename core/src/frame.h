@@ -32,9 +32,12 @@ struct FrameInputs {
   bool radial_depth = false;
   bool world_normals = true;
   double camera_to_world[16] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
-  float background_depth = 1e9f;  // depth >= this (or >= clip_end when > 0) is background
-  float clip_end = 0.0f;
+  // The background rule (ssao.h): a planar depth d is geometry when 0 < d < background_limit.
+  float background_limit = 1e9f;
 };
+
+// background_limit from the parameters background_depth and clip_end (0: no clip).
+float background_limit(double background_depth, double clip_end);
 
 // Unit vector <-> 32 bits: octahedral mapping with 16 bits per coordinate (error < 1e-4 rad).
 // Both directions are branch-free (the lower half folded over the diagonals by a signed
@@ -69,6 +72,12 @@ inline Vec3 decode_normal(uint32_t bits) {
 class Frame {
  public:
   static constexpr float kBackground = std::numeric_limits<float>::infinity();
+
+  // The caller's depths of pixels [x0, x0 + count) of a row (v: the row's centre) as planar
+  // depth in place, kBackground where the background rule says so: the library's one test of
+  // what is geometry (ssao.h), for the frame and for the automatic radius.
+  static void planar_depth_row(const CameraIntrinsics& camera, float* depth, int x0, int count,
+                               float v, bool radial, float limit);
 
   Frame() = default;
   // Sizes the planes for a frame (keeping their memory when the size is unchanged, so a job
@@ -136,7 +145,6 @@ class Frame {
                         NormalRow& scratch);
   static void nearest_of_blocks(const float* top, const float* bottom, int count, float* depth,
                                 int32_t* corner);
-  void depth_row(float* depth, int x0, int count, float v, bool radial, float limit) const;
   void encode_normal_row(const float* rotation, float v, int x0, int count, const float* nx,
                          const float* ny, const float* nz, uint32_t* usable, uint32_t* out) const;
 

@@ -89,6 +89,35 @@ struct Shaping {
   }
 };
 
+// Adds a row's geometry pixels (depth not background) and the sum of their AO to the counts.
+// Eight independent float sums (a row is at most a tile wide), so that the loop vectorises
+// without reassociating: the result does not depend on the vector width.
+SSAO_VECTORIZE void count_geometry_row(const float* __restrict depth, const float* __restrict ao,
+                                       int count, size_t& geometry, double& sum) {
+  constexpr int kLanes = 8;
+  float lane_sum[kLanes] = {};
+  int lane_count[kLanes] = {};
+  int i = 0;
+  for (; i + kLanes <= count; i += kLanes) {
+    for (int k = 0; k < kLanes; ++k) {  // loads outside the condition: a select, no branch
+      const float value = ao[i + k];
+      const bool surface = depth[i + k] < Frame::kBackground;
+      lane_sum[k] += surface ? value : 0.0f;
+      lane_count[k] += surface ? 1 : 0;
+    }
+  }
+  for (int k = 0; i < count; ++i, ++k) {
+    const float value = ao[i];
+    const bool surface = depth[i] < Frame::kBackground;
+    lane_sum[k] += surface ? value : 0.0f;
+    lane_count[k] += surface ? 1 : 0;
+  }
+  for (int k = 0; k < kLanes; ++k) {
+    sum += double(lane_sum[k]);
+    geometry += size_t(lane_count[k]);
+  }
+}
+
 // Pixels [x, x + count) of row y of `out` from the AO of a row: grey in the first three
 // channels, alpha 1. The pointer steps by the pixel stride (a multiple of 4 bytes).
 void write_ao_row(const float* ao, int count, const ImageView& out, int x, int y) {
@@ -219,19 +248,16 @@ double Job::auto_radius() const {
   const ParamValues& v = params_;
   const CameraModel camera = input_camera(window);
   const bool radial = v.get_string("depth_kind") == "radial";
-  double limit = v.get_float("background_depth");
-  if (v.get_float("clip_end") > 0.0) limit = std::min(limit, v.get_float("clip_end"));
+  const float limit = background_limit(v.get_float("background_depth"), v.get_float("clip_end"));
   const size_t pixels = size_t(width) * size_t(height);
   const size_t step = std::max<size_t>(1, pixels / kAutoRadiusSamples);
   std::vector<float> planar;
   planar.reserve(std::min(pixels, kAutoRadiusSamples + 1));
   for (size_t i = 0; i < pixels; i += step) {
     const int x = window.x0 + int(i % size_t(width)), y = window.y0 + int(i / size_t(width));
-    const float d = depth_.pixel(x, y)[0];
-    if (!(std::isfinite(d) && d > 0.0f && double(d) < limit)) continue;
-    // Radial depth over the length of the pixel's ray at planar depth 1.
-    planar.push_back(
-        radial ? d / length(camera.view_position(float(x) + 0.5f, float(y) + 0.5f, 1.0f)) : d);
+    float d = depth_.pixel(x, y)[0];
+    Frame::planar_depth_row(camera.intrinsics(), &d, x, 1, float(y) + 0.5f, radial, limit);
+    if (d != Frame::kBackground) planar.push_back(d);
   }
   if (planar.empty()) {
     throw_invalid_operation(
@@ -390,12 +416,21 @@ TilePool& Job::pool(int threads) {
   return *pool_;
 }
 
+Job::RunStats Job::last_run() const {
+  if (!has_run_) throw_invalid_operation("no successful run yet: call ssao_job_run first");
+  return last_run_;
+}
+
 void Job::run() {
+  has_run_ = false;
   validate_images();
   const int width = depth_.width, height = depth_.height;
   // An empty window (an empty depth image among them: the window lies inside it) does nothing.
   const Tile window = output_window();
-  if (window.x1 == window.x0 || window.y1 == window.y0) return;
+  if (window.x1 == window.x0 || window.y1 == window.y0) {
+    last_run_ = RunStats{}, has_run_ = true;
+    return;
+  }
 
   const ParamValues& v = params_;
   const CameraModel camera = input_camera(window);
@@ -412,10 +447,7 @@ void Job::run() {
   const std::vector<double>& matrix = v.get_floats("camera_to_world");
   if (in.normal.attached() && in.world_normals) require_invertible_rotation(matrix);
   std::copy(matrix.begin(), matrix.end(), in.camera_to_world);
-  in.background_depth = static_cast<float>(
-      std::min(v.get_float("background_depth"), double(std::numeric_limits<float>::max())));
-  in.clip_end = static_cast<float>(
-      std::min(v.get_float("clip_end"), double(std::numeric_limits<float>::max())));
+  in.background_limit = background_limit(v.get_float("background_depth"), v.get_float("clip_end"));
 
   progress.set_stage(0.0, 0.05);
   // The frame the variant sees: the input's, or a half-resolution copy (a quarter of the work;
@@ -471,7 +503,14 @@ void Job::run() {
       static_cast<float>(v.get_float("remap_min")), static_cast<float>(v.get_float("remap_max"))};
   Progress uncancellable(nullptr, nullptr);
   const int dx = window.x0, dy = window.y0;  // output pixel (x - dx, y - dy) is frame pixel (x, y)
+  // The statistics per output tile, summed in tile order afterwards: the same for any thread
+  // count.
+  const int tiles_across = (window.x1 - dx + kTileWidth - 1) / kTileWidth;
+  const int tiles_down = (window.y1 - dy + kTileHeight - 1) / kTileHeight;
+  std::vector<RunStats> tile_stats(size_t(tiles_across) * size_t(tiles_down), RunStats{0, 0.0});
   tiles.for_each_tile(window.x1 - dx, window.y1 - dy, uncancellable, [&](const Tile& output) {
+    RunStats& stats = tile_stats[size_t(output.y0 / kTileHeight) * size_t(tiles_across) +
+                                 size_t(output.x0 / kTileWidth)];
     const Tile t{output.x0 + dx, output.y0 + dy, output.x1 + dx, output.y1 + dy};
     ScratchVector<float> denoised(size_t(t.x1 - t.x0) * size_t(t.y1 - t.y0));
     ScratchVector<float> coverage(composite_out_.attached() ? size_t(t.x1 - t.x0) : 0);
@@ -485,7 +524,9 @@ void Job::run() {
     const int count = t.x1 - t.x0;
     for (int y = t.y0; y < t.y1; ++y) {
       float* values = denoised.data() + size_t(y - t.y0) * count;
-      shaping.apply(frame.depth_plane() + frame.index(t.x0, y), values, count);
+      const float* depth = frame.depth_plane() + frame.index(t.x0, y);
+      shaping.apply(depth, values, count);
+      count_geometry_row(depth, values, count, stats.geometry_pixels, stats.mean_ao);  // a sum
       if (ao_out_.attached()) write_ao_row(values, count, ao_out_, t.x0 - dx, y - dy);
       if (composite_out_.attached()) {
         coverage_row(frame, normal_, beauty_, t.x0, t.x1, y, dx, dy, coverage.data());
@@ -494,6 +535,13 @@ void Job::run() {
       }
     }
   });
+  RunStats total{0, 0.0};
+  for (const RunStats& tile : tile_stats) {
+    total.geometry_pixels += tile.geometry_pixels;
+    total.mean_ao += tile.mean_ao;
+  }
+  total.mean_ao = total.geometry_pixels > 0 ? total.mean_ao / double(total.geometry_pixels) : 1.0;
+  last_run_ = total, has_run_ = true;
   progress.report(1.0);
 }
 

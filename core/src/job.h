@@ -32,6 +32,15 @@ class Job {
   // The automatic radius rule (docs/parameters.md) for the attached depth image and camera.
   double auto_radius() const;
 
+  // What the last successful run saw over the frame (the output window): the pixels the
+  // background rule took as geometry and the mean of their final AO (1 without any).
+  struct RunStats {
+    size_t geometry_pixels = 0;
+    double mean_ao = 1.0;
+  };
+  // Throws invalid_operation before a successful run.
+  RunStats last_run() const;
+
  private:
   void validate_images() const;
   // The output window in input pixels: (x, y) and the outputs' size (the whole depth image
@@ -57,6 +66,8 @@ class Job {
 
   ImageView depth_, normal_, beauty_, ambient_, ao_out_, composite_out_;
   ImageView layers_[kMaxExtraLayers], facing_[kMaxExtraLayers];
+  RunStats last_run_;
+  bool has_run_ = false;
   bool windowed_ = false;
   int window_x_ = 0, window_y_ = 0;
   Progress::Callback progress_callback_ = nullptr;

@@ -57,6 +57,26 @@ class NativeBindingTest(unittest.TestCase):
             with self.assertRaisesRegex(ssao_native.SSAOError, "float32"):
                 job.set_image("depth", np.zeros((4, 4), np.float64))
 
+    def test_last_run_counts_geometry_and_its_mean_ao(self):
+        depth = corner_scene()
+        depth[:, :6] = np.inf       # sky
+        depth[5, 30] = np.nan       # hostile values are background too
+        depth[6, 30] = -1.0
+        ao = np.full(depth.shape, -1.0, np.float32)
+        with ssao_native.Job(self.lib) as job:
+            job.set("lens", 35.0)
+            job.set("radius", 1.0)
+            job.set_image("depth", depth)
+            job.set_image("ao", ao)
+            with self.assertRaisesRegex(ssao_native.SSAOError, "no successful run"):
+                job.last_run()
+            job.run()
+            geometry, mean = job.last_run()
+        mask = np.isfinite(depth) & (depth > 0)
+        self.assertEqual(geometry, int(mask.sum()))
+        self.assertAlmostEqual(mean, float(ao[mask].astype(np.float64).mean()), places=9)
+        self.assertLess(mean, 1.0)
+
     def test_corner_is_darker_at_the_crease(self):
         depth = corner_scene()
         ao = self.run_ao(depth, radius=1.0)

@@ -443,6 +443,99 @@ TEST(Api, AutoRadiusIsATenthOfTheViewWidthAtTheMedianDepth) {
   EXPECT_EQ(ssao_job_auto_radius(nullptr, &radius), SSAO_ERROR_INVALID_ARGUMENT);
 }
 
+TEST(Api, LastRunReportsGeometryByTheOneBackgroundRule) {
+  // A wall at planar depth 5 seen with radial depth, clip_end 5.1: towards the corners the
+  // radial values exceed 5.1 but the planar depth, which the rule tests, does not. Hostile
+  // values (NaN, inf, <= 0, beyond background_depth) are background.
+  Camera cam;
+  const int w = cam.width, h = cam.height;
+  std::vector<float> radial(size_t(w) * h);
+  size_t beyond_clip = 0, expected_geometry = 0;
+  for (int y = 0; y < h; ++y) {
+    for (int x = 0; x < w; ++x) {
+      V3 origin, direction;
+      cam.ray(x, y, origin, direction);
+      float& d = radial[size_t(y) * w + x];
+      d = float(5.0 * std::sqrt(dot(direction, direction)));
+      if (d >= 5.1f) ++beyond_clip;
+      const size_t i = size_t(y) * w + x;
+      if (i % 11 == 0) d = std::nanf("");
+      if (i % 11 == 1) d = HUGE_VALF;
+      if (i % 11 == 2) d = -1.0f;
+      if (i % 11 == 3) d = 2e9f;  // beyond background_depth (1e9)
+      if (i % 11 > 3) ++expected_geometry;
+    }
+  }
+  ASSERT_GT(beyond_clip, 0u);
+  std::vector<float> ao(size_t(w) * h, -1.0f);
+  Job job;
+  job.camera(cam);
+  job.set("depth_kind", "radial");
+  job.set("clip_end", 5.1);
+  job.set("radius", 0.5);
+  size_t geometry = 0;
+  double mean = 0.0;
+  EXPECT_EQ(ssao_job_last_run(job.get(), &geometry, &mean), SSAO_ERROR_INVALID_OPERATION);
+  job.image("depth", radial, w, h, 1);
+  job.image("ao", ao, w, h, 1);
+  ASSERT_EQ(job.run(), SSAO_OK) << ssao_last_error();
+  ASSERT_EQ(ssao_job_last_run(job.get(), &geometry, &mean), SSAO_OK) << ssao_last_error();
+  EXPECT_EQ(geometry, expected_geometry);
+  double sum = 0.0;
+  for (size_t i = 0; i < ao.size(); ++i) {
+    if (i % 11 > 3) sum += ao[i];
+  }
+  EXPECT_NEAR(mean, sum / double(expected_geometry), 1e-9);
+  EXPECT_LT(mean, 1.0);  // the sky darkens nothing, but the wall's holes are corners
+  // The automatic radius counts the same pixels as geometry: the median planar depth is 5.
+  double radius = 0.0;
+  ASSERT_EQ(ssao_job_auto_radius(job.get(), &radius), SSAO_OK);
+  EXPECT_NEAR(radius, 0.1 * 5.0 * cam.sensor / cam.lens, 1e-4);
+
+  // Every radial value at or beyond clip_end, every planar depth before it: all geometry, for
+  // the automatic radius as for the run (the two once disagreed).
+  std::vector<float> wall(size_t(w) * h);
+  for (int y = 0; y < h; ++y) {
+    for (int x = 0; x < w; ++x) {
+      V3 origin, direction;
+      cam.ray(x, y, origin, direction);
+      wall[size_t(y) * w + x] = float(5.0 * std::sqrt(dot(direction, direction)));
+    }
+  }
+  const double near_clip = 5.00002;
+  ASSERT_GE(*std::min_element(wall.begin(), wall.end()), float(near_clip));
+  Job clipped;
+  clipped.camera(cam);
+  clipped.set("depth_kind", "radial");
+  clipped.set("clip_end", near_clip);
+  clipped.image("depth", wall, w, h, 1);
+  clipped.image("ao", ao, w, h, 1);
+  ASSERT_EQ(ssao_job_auto_radius(clipped.get(), &radius), SSAO_OK) << ssao_last_error();
+  EXPECT_NEAR(radius, 0.1 * 5.0 * cam.sensor / cam.lens, 1e-4);
+  ASSERT_EQ(clipped.run(), SSAO_OK) << ssao_last_error();
+  ASSERT_EQ(ssao_job_last_run(clipped.get(), &geometry, &mean), SSAO_OK);
+  EXPECT_EQ(geometry, wall.size());
+
+  // A window counts its own pixels only (planar depth now: the camera describes the window, so
+  // the radial values above no longer fit it); a failed run leaves nothing to report.
+  job.set("depth_kind", "planar");
+  job.set("clip_end", 0.0);
+  std::vector<float> small(size_t(10) * 10, -1.0f);
+  job.image("ao", small, 10, 10, 1);
+  ASSERT_EQ(ssao_job_set_output_window(job.get(), 1, 20, 20), SSAO_OK);
+  ASSERT_EQ(job.run(), SSAO_OK) << ssao_last_error();
+  ASSERT_EQ(ssao_job_last_run(job.get(), &geometry, &mean), SSAO_OK);
+  size_t window_geometry = 0;
+  for (int y = 20; y < 30; ++y) {
+    for (int x = 20; x < 30; ++x) window_geometry += (size_t(y) * w + x) % 11 > 3;
+  }
+  EXPECT_EQ(geometry, window_geometry);
+  ASSERT_EQ(ssao_job_set_output_window(job.get(), 1, w, h), SSAO_OK);
+  EXPECT_NE(job.run(), SSAO_OK);
+  EXPECT_EQ(ssao_job_last_run(job.get(), &geometry, &mean), SSAO_ERROR_INVALID_OPERATION);
+  EXPECT_EQ(ssao_job_last_run(job.get(), nullptr, &mean), SSAO_ERROR_INVALID_ARGUMENT);
+}
+
 TEST(Api, StrengthPowerAndRemapShapeTheResult) {
   const Camera cam;
   Scene s = floor_and_wall(cam);

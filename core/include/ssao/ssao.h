@@ -190,6 +190,12 @@ SSAO_API ssao_status ssao_job_set_progress(ssao_job job, ssao_progress_fn fn, vo
 SSAO_API ssao_status ssao_job_auto_radius(ssao_job job, double* out);
 /* Computes AO and writes the attached outputs. A 0 x 0 image is valid and does nothing. */
 SSAO_API ssao_status ssao_job_run(ssao_job job);
+/* What the last successful ssao_job_run() of this job saw over the frame (the output window, or
+ * the whole image without one): how many pixels the background rule above took as geometry,
+ * and the mean of their final AO (after strength, power and remap: what "ao" holds; 1 when
+ * there is no geometry pixel). Front ends report these instead of testing depths themselves.
+ * SSAO_ERROR_INVALID_OPERATION when the job has not run, or its last run failed. */
+SSAO_API ssao_status ssao_job_last_run(ssao_job job, size_t* geometry_pixels, double* mean_ao);
 
 #ifdef __cplusplus
 }

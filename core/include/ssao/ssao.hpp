@@ -127,6 +127,17 @@ class Job {
   }
   void run() { check_status(ssao_job_run(job_), "SSAO failed"); }
 
+  // What the last run saw over the frame (ssao_job_last_run).
+  struct RunStats {
+    size_t geometry_pixels = 0;
+    double mean_ao = 1.0;
+  };
+  RunStats last_run() const {
+    RunStats stats;
+    check_status(ssao_job_last_run(job_, &stats.geometry_pixels, &stats.mean_ao), "last run");
+    return stats;
+  }
+
  private:
   ssao_job job_ = nullptr;
 };
