@@ -93,6 +93,8 @@ def _declare(lib):
     if hasattr(lib, "ssao_variant_count"):  # since 0.1 after 45f8526
         sig("ssao_variant_count", ctypes.c_size_t, checked=False)
         sig("ssao_variant_info", c_int, ctypes.c_size_t, ctypes.POINTER(_VariantDesc))
+    if hasattr(lib, "ssao_param_group"):  # since 0.1 after issue 23
+        sig("ssao_param_group", c_int, ctypes.c_size_t, ctypes.POINTER(ctypes.c_char_p))
     sig("ssao_job_create", c_int, ctypes.POINTER(ctypes.c_void_p))
     sig("ssao_job_destroy", None, job, checked=False)
     sig("ssao_job_set_int", c_int, job, cstr, c_int)
@@ -120,7 +122,11 @@ def parameters(lib):
         d = _ParamDesc()
         lib.ssao_param_info(i, ctypes.byref(d))
         text = lambda b: b.decode() if b is not None else None  # noqa: E731
+        group = ctypes.c_char_p()
+        if hasattr(lib, "ssao_param_group"):
+            lib.ssao_param_group(i, ctypes.byref(group))
         out.append({
+            "group": text(group.value),
             "name": text(d.name), "type": d.type, "default": d.default_value,
             "min": d.min_value, "max": d.max_value, "default_string": text(d.default_string),
             "choices": text(d.choices).split("|") if d.choices else None, "count": d.count,

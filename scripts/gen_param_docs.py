@@ -24,8 +24,14 @@ command line as `--name-with-dashes VALUE`, and (later) as a property of the Ble
 """
 
 PARAMS_HEADER = """
-| name | type | default | range / choices | unit | description |
-|---|---|---|---|---|---|
+Each parameter belongs to a group (`ssao_param_group()`): `ao` (what the estimate computes),
+`quality` (how much work it does), `shaping` (the final look), `input` (how the passes are to be
+read), `camera` (the camera they were rendered with: `projection` chooses Blender's lens and
+sensor, pinhole `intrinsics` or a `projection_matrix`; see [conventions.md](conventions.md)) and
+`execution`. Front ends select by group: the Blender node shows `ao`, `quality` and `shaping`.
+
+| name | group | type | default | range / choices | unit | description |
+|---|---|---|---|---|---|---|
 """
 
 FOOTER = """
@@ -87,11 +93,12 @@ def render(lib):
         if p["type"] == ssao_native.PARAM_STRING:
             default, span = f"`{p['default_string']}`", " \\| ".join(f"`{c}`" for c in p["choices"])
         elif p["type"] == ssao_native.PARAM_FLOATS:
-            default, span = "identity", f"{p['count']} values"
+            default = "identity" if p["count"] == 16 else "unset (zeros)"
+            span = f"{p['count']} values"
         else:
             default = number(p["default"])
             span = f"{number(p['min'])} .. {number(p['max'])}"
-        rows.append(f"| `{p['name']}` | {TYPES[p['type']]} | {default} | {span} | {p['unit']} "
+        rows.append(f"| `{p['name']}` | {p['group']} | {TYPES[p['type']]} | {default} | {span} | {p['unit']} "
                     f"| {p['description']} |")
     return HEADER + render_variants(lib) + PARAMS_HEADER + "\n".join(rows) + "\n" + FOOTER
 

@@ -76,6 +76,13 @@ SSAO_API ssao_status ssao_param_info(size_t index, ssao_param_desc* out) {
   });
 }
 
+SSAO_API ssao_status ssao_param_group(size_t index, const char** group) {
+  return guarded([&] {
+    if (group == nullptr) ssao::throw_invalid_argument("output pointer is NULL");
+    *group = ssao::param_group(index);
+  });
+}
+
 SSAO_API size_t ssao_variant_count(void) { return ssao::variant_registry().size(); }
 
 SSAO_API ssao_status ssao_variant_info(size_t index, ssao_variant_desc* out) {

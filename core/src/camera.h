@@ -33,6 +33,15 @@ class CameraModel {
   // Mirrors Blender's viewplane computation (BKE_camera_params_compute_viewplane).
   CameraModel(const CameraParams& params, int width, int height);
 
+  // The pinhole numbers: focal lengths in pixels (orthographic: pixels per scene unit) and the
+  // principal point in continuous image coordinates (x right, y down, pixel (0, 0) centred at
+  // (0.5, 0.5)). Throws invalid_argument unless fx, fy > 0 and every number is finite.
+  static CameraModel from_intrinsics(bool orthographic, double fx, double fy, double cx, double cy);
+  // An OpenGL-style view-to-clip matrix (row-major), perspective (last row 0 0 -1 0) or
+  // orthographic (last row 0 0 0 1), on a width x height image. Throws invalid_argument for a
+  // matrix of another shape (skew, a last row of neither kind, a non-positive scale).
+  static CameraModel from_projection_matrix(const double* m, int width, int height);
+
   // The same camera on an image `factor` times coarser (pixel (i, j) covers pixels
   // [factor i, factor (i + 1)) x [factor j, factor (j + 1)) of this one).
   CameraModel coarser(int factor) const {
@@ -93,6 +102,8 @@ class CameraModel {
   }
 
  private:
+  CameraModel() = default;
+
   bool orthographic_ = false;
   float scale_u_ = 1.0f, scale_v_ = 1.0f;    // view units per pixel (at unit depth if PERSP)
   float center_u_ = 0.0f, center_v_ = 0.0f;  // principal point in continuous image coordinates

@@ -45,6 +45,21 @@ CameraParams camera_params(const ParamValues& v) {
   return c;
 }
 
+// The camera of a width x height frame as the parameter "projection" says it is given.
+CameraModel frame_camera(const ParamValues& v, int width, int height) {
+  const std::string& projection = v.get_string("projection");
+  if (projection == "intrinsics") {
+    const std::vector<double>& k = v.get_floats("intrinsics");
+    return CameraModel::from_intrinsics(v.get_string("camera_type") == "ORTHO", k[0], k[1], k[2],
+                                        k[3]);
+  }
+  if (projection == "matrix") {
+    return CameraModel::from_projection_matrix(v.get_floats("projection_matrix").data(), width,
+                                               height);
+  }
+  return CameraModel(camera_params(v), width, height);
+}
+
 // World-space normals are turned into view space through camera_to_world's 3x3 part; a
 // singular one (zero or parallel axes) would flatten them into wrong normals without a word.
 // The determinant is compared with the product of the column lengths: scale does not matter.
@@ -236,8 +251,8 @@ Tile Job::output_window() const {
 }
 
 CameraModel Job::input_camera(const Tile& w) const {
-  return CameraModel(camera_params(params_), std::max(w.x1 - w.x0, 1), std::max(w.y1 - w.y0, 1))
-      .moved_by(w.x0, w.y0);
+  const int width = std::max(w.x1 - w.x0, 1), height = std::max(w.y1 - w.y0, 1);
+  return frame_camera(params_, width, height).moved_by(w.x0, w.y0);
 }
 
 double Job::auto_radius() const {

@@ -12,26 +12,44 @@ namespace {
 
 constexpr double kInf = HUGE_VAL;
 
-ssao_param_desc int_param(const char* name, int def, int lo, int hi, const char* unit,
-                          const char* description) {
-  return {name,    SSAO_PARAM_INT, double(def), double(lo), double(hi),
-          nullptr, nullptr,        1,           unit,       description};
+// A parameter and its group (ssao_param_group): what front ends select by.
+struct Param {
+  const char* group;
+  ssao_param_desc desc;
+};
+
+Param int_param(const char* group, const char* name, int def, int lo, int hi, const char* unit,
+                const char* description) {
+  return {group,
+          {name, SSAO_PARAM_INT, double(def), double(lo), double(hi), nullptr, nullptr, 1, unit,
+           description}};
 }
-ssao_param_desc float_param(const char* name, double def, double lo, double hi, const char* unit,
-                            const char* description) {
-  return {name, SSAO_PARAM_FLOAT, def, lo, hi, nullptr, nullptr, 1, unit, description};
+Param float_param(const char* group, const char* name, double def, double lo, double hi,
+                  const char* unit, const char* description) {
+  return {group, {name, SSAO_PARAM_FLOAT, def, lo, hi, nullptr, nullptr, 1, unit, description}};
 }
-ssao_param_desc string_param(const char* name, const char* def, const char* choices,
-                             const char* description) {
-  return {name, SSAO_PARAM_STRING, 0.0, 0.0, 0.0, def, choices, 1, "", description};
+Param string_param(const char* group, const char* name, const char* def, const char* choices,
+                   const char* description) {
+  return {group, {name, SSAO_PARAM_STRING, 0.0, 0.0, 0.0, def, choices, 1, "", description}};
 }
+Param matrix_param(const char* group, const char* name, const char* description) {
+  return {group, {name, SSAO_PARAM_FLOATS, 0.0, 0.0, 0.0, nullptr, nullptr, 16, "", description}};
+}
+
+// Groups, in the order front ends show them.
+constexpr const char* kAo = "ao";            // what the estimate computes
+constexpr const char* kQuality = "quality";  // how much work it does
+constexpr const char* kShaping = "shaping";  // the AO's final look
+constexpr const char* kInput = "input";      // how the caller's passes are to be read
+constexpr const char* kCamera = "camera";    // the camera the passes were rendered with
+constexpr const char* kExecution = "execution";
 
 // Defaults marked "measured" were chosen by the run-time-vs-error benchmark against Cycles'
 // AO pass (benchmarks/, docs/accuracy.md).
-const std::vector<ssao_param_desc>& table() {
-  static const std::vector<ssao_param_desc> params = {
+const std::vector<Param>& params() {
+  static const std::vector<Param> params = {
       // --- algorithm ---
-      string_param("variant", "hemisphere", "horizon|hemisphere|sphere|volumetric|unsharp",
+      string_param(kAo, "variant", "hemisphere", "horizon|hemisphere|sphere|volumetric|unsharp",
                    "horizon: horizon-based slices with a visibility bitmask (GTAO), kept for "
                    "comparison: 7-15x the default's time and less accurate on the benchmark "
                    "scenes but the one with thin occluders (docs/variants.md); hemisphere: "
@@ -39,84 +57,115 @@ const std::vector<ssao_param_desc>& table() {
                    "volumetric: line-integral obscurance of a sphere along view rays (depth "
                    "only); unsharp: depth unsharp masking, the local mean depth against the "
                    "pixel's (depth only)"),
-      float_param("radius", 1.0, 1e-6, 1e9, "scene units",
+      float_param(kAo, "radius", 1.0, 1e-6, 1e9, "scene units",
                   "distance within which geometry occludes, as Cycles' AO distance"),
-      string_param("quality", "medium", "low|medium|high|ultra",
+      string_param(kQuality, "quality", "medium", "low|medium|high|ultra",
                    "sample counts of the variant (samples, slices, steps) that are left at 0; "
                    "medium is the measured balance of time and error"),
-      int_param("samples", 0, 0, 1024, "directions per pixel",
+      int_param(kQuality, "samples", 0, 0, 1024, "directions per pixel",
                 "hemisphere: kernel directions per pixel; sphere: points per pixel; volumetric: "
                 "view rays per pixel; 0: from quality"),
-      int_param("slices", 0, 0, 64, "slices per pixel",
+      int_param(kQuality, "slices", 0, 0, 64, "slices per pixel",
                 "horizon: screen-space lines through each pixel; 0: from quality"),
-      int_param("steps", 0, 0, 64, "samples per direction",
+      int_param(kQuality, "steps", 0, 0, 64, "samples per direction",
                 "hemisphere: samples along each direction, the strongest occluder counts (1 is "
                 "the classic kernel of independent points); horizon: samples on each side of a "
                 "slice; 0: from quality"),
-      float_param("bias", 0.02, 0.0, 1.0, "fraction of radius",
+      float_param(kAo, "bias", 0.02, 0.0, 1.0, "fraction of radius",
                   "height above the receiver's tangent plane (hemisphere, horizon) or behind the "
                   "sample (sphere) an occluder needs to count; one pixel footprint is added"),
-      float_param("sample_clustering", 1.0, 0.0, 4.0, "exponent",
+      float_param(kAo, "sample_clustering", 1.0, 0.0, 4.0, "exponent",
                   "samples sit at radius * lerp(0.1, 1, s^p) for s uniform in [0,1): 0 puts all "
                   "on the kernel's surface, 2 clusters them toward the centre as the seed code "
                   "does (measured)"),
       float_param(
-          "thickness", 0.5, 0.01, 100.0, "fraction of radius",
+          kAo, "thickness", 0.5, 0.01, 100.0, "fraction of radius",
           "assumed thickness of surfaces: horizon: an occluder spans this far behind the visible "
           "surface; hemisphere: a sample this far behind the visible surface counts fully, "
           "fading out at twice the distance (range check against halos); volumetric: a ray "
           "whose visible surface is this far in front of the sphere counts fully, fading out "
           "at twice the distance"),
-      string_param("sphere_mode", "normalized", "normalized|classic",
+      string_param(kAo, "sphere_mode", "normalized", "normalized|classic",
                    "sphere variant: classic reads about 0.5 on a flat wall; normalized maps an "
                    "unoccluded flat surface to 1"),
-      int_param("seed", 0, 0, 2147483647, "", "seed of the kernel rotation pattern"),
-      string_param("resolution", "auto", "auto|full|half",
+      int_param(kQuality, "seed", 0, 0, 2147483647, "", "seed of the kernel rotation pattern"),
+      string_param(kQuality, "resolution", "auto", "auto|full|half",
                    "full: AO estimated at every pixel; half: at half resolution in each axis (a "
                    "quarter of the work), then upsampled guided by depth and normals; auto: half "
                    "for frames of at least 1 megapixel, where it costs almost no accuracy "
                    "(measured)"),
       // --- denoising ---
-      string_param("denoise", "bilateral", "bilateral|box4|none",
+      string_param(kQuality, "denoise", "bilateral", "bilateral|box4|none",
                    "bilateral: depth- and normal-aware blur; box4: the seed code's 4x4 box blur; "
                    "none: raw estimate"),
       // --- output shaping: ao = remap_min + (remap_max - remap_min) * mix(1, raw^power, strength)
-      float_param("strength", 1.0, 0.0, 1.0, "",
+      float_param(kShaping, "strength", 1.0, 0.0, 1.0, "",
                   "0 leaves the image unchanged, 1 applies the full AO"),
-      float_param("power", 1.0, 0.1, 10.0, "", "AO is raised to this power before strength"),
-      float_param("remap_min", 0.0, 0.0, 1.0, "", "AO value that full occlusion maps to"),
-      float_param("remap_max", 1.0, 0.0, 1.0, "", "AO value that no occlusion maps to"),
+      float_param(kShaping, "power", 1.0, 0.1, 10.0, "",
+                  "AO is raised to this power before strength"),
+      float_param(kShaping, "remap_min", 0.0, 0.0, 1.0, "", "AO value that full occlusion maps to"),
+      float_param(kShaping, "remap_max", 1.0, 0.0, 1.0, "", "AO value that no occlusion maps to"),
       // --- input conventions ---
-      string_param("depth_kind", "planar", "planar|radial",
+      string_param(kInput, "depth_kind", "planar", "planar|radial",
                    "planar: distance along the view axis (Blender's Depth pass); radial: distance "
                    "along the pixel's ray"),
-      string_param("normal_space", "world", "world|camera",
+      string_param(kInput, "normal_space", "world", "world|camera",
                    "space of the normal image; world needs camera_to_world"),
-      float_param("background_depth", 1e9, 0.0, kInf, "scene units",
+      float_param(kInput, "background_depth", 1e9, 0.0, kInf, "scene units",
                   "depths at or beyond this are background (Blender writes 1e10)"),
       // --- camera (Blender's bpy.types.Camera names) ---
-      string_param("camera_type", "PERSP", "PERSP|ORTHO", "perspective or orthographic camera"),
-      float_param("lens", 50.0, 1e-6, 1e9, "mm", "focal length (PERSP)"),
-      float_param("sensor_width", 36.0, 1e-6, 1e9, "mm", "sensor width"),
-      float_param("sensor_height", 24.0, 1e-6, 1e9, "mm", "sensor height"),
-      string_param("sensor_fit", "AUTO", "AUTO|HORIZONTAL|VERTICAL",
+      string_param(kCamera, "camera_type", "PERSP", "PERSP|ORTHO",
+                   "perspective or orthographic camera"),
+      float_param(kCamera, "lens", 50.0, 1e-6, 1e9, "mm", "focal length (PERSP)"),
+      float_param(kCamera, "sensor_width", 36.0, 1e-6, 1e9, "mm", "sensor width"),
+      float_param(kCamera, "sensor_height", 24.0, 1e-6, 1e9, "mm", "sensor height"),
+      string_param(kCamera, "sensor_fit", "AUTO", "AUTO|HORIZONTAL|VERTICAL",
                    "AUTO fits sensor_width to the larger image side"),
-      float_param("shift_x", 0.0, -1e3, 1e3, "fitted image side", "horizontal lens shift"),
-      float_param("shift_y", 0.0, -1e3, 1e3, "fitted image side", "vertical lens shift"),
-      float_param("ortho_scale", 6.0, 1e-9, 1e12, "scene units",
+      float_param(kCamera, "shift_x", 0.0, -1e3, 1e3, "fitted image side", "horizontal lens shift"),
+      float_param(kCamera, "shift_y", 0.0, -1e3, 1e3, "fitted image side", "vertical lens shift"),
+      float_param(kCamera, "ortho_scale", 6.0, 1e-9, 1e12, "scene units",
                   "width of the view along the fitted side (ORTHO)"),
-      float_param("clip_start", 0.1, 0.0, kInf, "scene units", "near clip (informational)"),
-      float_param("clip_end", 0.0, 0.0, kInf, "scene units",
+      float_param(kCamera, "clip_start", 0.1, 0.0, kInf, "scene units",
+                  "near clip (informational)"),
+      float_param(kCamera, "clip_end", 0.0, 0.0, kInf, "scene units",
                   "depths at or beyond this are background; 0 disables the test"),
-      float_param("pixel_aspect_x", 1.0, 1e-6, 1e6, "", "pixel aspect ratio, x"),
-      float_param("pixel_aspect_y", 1.0, 1e-6, 1e6, "", "pixel aspect ratio, y"),
-      {"camera_to_world", SSAO_PARAM_FLOATS, 0.0, 0.0, 0.0, nullptr, nullptr, 16, "",
-       "camera-to-world matrix, 16 values row by row (Blender's matrix_world); identity by "
-       "default; used to bring world-space normals into view space"},
+      float_param(kCamera, "pixel_aspect_x", 1.0, 1e-6, 1e6, "", "pixel aspect ratio, x"),
+      float_param(kCamera, "pixel_aspect_y", 1.0, 1e-6, 1e6, "", "pixel aspect ratio, y"),
+      matrix_param(kCamera, "camera_to_world",
+                   "camera-to-world matrix, 16 values row by row (Blender's matrix_world); "
+                   "identity by default; used to bring world-space normals into view space"),
       // --- execution ---
-      int_param("threads", 0, 0, 1024, "threads", "0 uses every core; results do not depend on it"),
+      int_param(kExecution, "threads", 0, 0, 1024, "threads",
+                "0 uses every core; results do not depend on it"),
+      // --- camera contract: any renderer's camera, beside Blender's lens and sensor above ---
+      string_param(kCamera, "projection", "lens", "lens|intrinsics|matrix",
+                   "how the camera is given: lens: Blender's camera (camera_type, lens, sensor, "
+                   "sensor_fit, shift, ortho_scale, pixel aspect); intrinsics: the pinhole "
+                   "numbers fx, fy, cx, cy of the intrinsics parameter (camera_type still "
+                   "chooses perspective or orthographic); matrix: an OpenGL-style projection "
+                   "matrix (projection_matrix; perspective or orthographic from its last row)"),
+      {kCamera,
+       {"intrinsics", SSAO_PARAM_FLOATS, 0.0, 0.0, 0.0, nullptr, nullptr, 4, "pixels",
+        "fx, fy, cx, cy (projection = intrinsics): focal lengths in pixels (orthographic: "
+        "pixels per scene unit) and the principal point in image coordinates, x right and y "
+        "down from the top-left corner, pixel (0, 0) centred at (0.5, 0.5) (OpenCV's cx + "
+        "0.5); describe the frame (the output window with overscan)"}},
+      matrix_param(kCamera, "projection_matrix",
+                   "projection = matrix: the view-to-clip matrix, 16 values row by row (OpenGL: "
+                   "view space looks down -Z, clip space to NDC [-1, 1], +Y up; Blender's "
+                   "camera.calc_matrix_camera()); no skew; describes the frame"),
   };
   return params;
+}
+
+// The descriptions alone, in table order: what ssao_param_info hands out.
+const std::vector<ssao_param_desc>& table() {
+  static const std::vector<ssao_param_desc> descs = [] {
+    std::vector<ssao_param_desc> out;
+    for (const Param& p : params()) out.push_back(p.desc);
+    return out;
+  }();
+  return descs;
 }
 
 bool is_choice(const ssao_param_desc& d, const char* value) {
@@ -165,6 +214,11 @@ void check_range(const ssao_param_desc& d, double value) {
 
 size_t param_count() { return table().size(); }
 
+const char* param_group(size_t index) {
+  param_desc(index);  // the range check and its message
+  return params()[index].group;
+}
+
 const ssao_param_desc& param_desc(size_t index) {
   if (index >= table().size()) {
     throw_invalid_argument("parameter index " + std::to_string(index) + " out of range (" +
@@ -180,8 +234,10 @@ ParamValues::ParamValues() : values_(table().size()) {
     if (d.type == SSAO_PARAM_STRING) values_[i].text = d.default_string;
     if (d.type == SSAO_PARAM_FLOATS) {
       values_[i].floats.assign(d.count, 0.0);
-      // The only array parameter is a 4x4 matrix: identity by default.
-      for (size_t k = 0; k < d.count; k += 5) values_[i].floats[k] = 1.0;
+      // 4x4 matrices are the identity by default; the intrinsics, zeros (unset: refused).
+      if (d.count == 16) {
+        for (size_t k = 0; k < d.count; k += 5) values_[i].floats[k] = 1.0;
+      }
     }
   }
 }

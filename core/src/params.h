@@ -12,6 +12,8 @@ namespace ssao {
 
 size_t param_count();
 const ssao_param_desc& param_desc(size_t index);
+// "ao", "quality", "shaping", "input", "camera" or "execution" (ssao.h, ssao_param_group).
+const char* param_group(size_t index);
 
 // Current values of every parameter of one job, validated on every set.
 class ParamValues {

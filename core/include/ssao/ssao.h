@@ -27,6 +27,13 @@
  *   along the pixel's ray ("radial"). A depth that is NaN, infinite, <= 0, >= background_depth
  *   or >= clip_end (when clip_end > 0) marks a background pixel: it is never an occluder and its
  *   AO is 1 (unoccluded).
+ * - The camera: one contract for any renderer, chosen by the parameter "projection" (all in
+ *   the "camera" group): "lens" (the default) is Blender's camera (camera_type, lens,
+ *   sensor_width/height, sensor_fit, shift_x/y, ortho_scale, pixel_aspect_x/y); "intrinsics"
+ *   takes fx, fy, cx, cy in pixels ("intrinsics", camera_type choosing perspective or
+ *   orthographic); "matrix" takes an OpenGL-style view-to-clip matrix ("projection_matrix").
+ *   Every form describes the frame (the output window, with overscan); depth may be planar or
+ *   radial ("depth_kind") with any of them.
  * - AO is visibility: 1 = unoccluded, 0 = fully occluded.
  * - Results are bitwise identical for any thread count.
  *
@@ -112,6 +119,17 @@ SSAO_API const char* ssao_last_error(void);
 SSAO_API size_t ssao_param_count(void);
 /* Describes parameter number "index" (0 <= index < ssao_param_count()). */
 SSAO_API ssao_status ssao_param_info(size_t index, ssao_param_desc* out);
+/* The group of parameter number "index" (a static string), so that front ends select
+ * parameters by group instead of keeping lists of names:
+ *   "ao"        what the estimate computes (variant, radius, bias, thickness, ...)
+ *   "quality"   how much work it does (quality, samples, resolution, denoise, seed, ...)
+ *   "shaping"   the final look (strength, power, remap_min, remap_max)
+ *   "input"     how the caller's passes are to be read (depth_kind, normal_space, ...)
+ *   "camera"    the camera the passes were rendered with (see "The camera" below)
+ *   "execution" how the run is executed (threads); results do not depend on it
+ * A front end that shows "ao", "quality" and "shaping" shows every parameter that changes the
+ * look; new parameters join one of these groups. */
+SSAO_API ssao_status ssao_param_group(size_t index, const char** group);
 
 /* Returns the number of variants; index them with ssao_variant_info(). */
 SSAO_API size_t ssao_variant_count(void);

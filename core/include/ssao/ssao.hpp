@@ -34,6 +34,14 @@ inline void check_status(ssao_status status, const std::string& what) {
   throw Error(status, what.empty() ? detail : what + ": " + detail);
 }
 
+// The group of parameter number `index` (ssao_param_group): "ao", "quality", "shaping",
+// "input", "camera" or "execution".
+inline std::string param_group(size_t index) {
+  const char* group = nullptr;
+  check_status(ssao_param_group(index, &group), "");
+  return group;
+}
+
 // Every parameter of the core, in table order.
 inline std::vector<ssao_param_desc> param_table() {
   std::vector<ssao_param_desc> table(ssao_param_count());
