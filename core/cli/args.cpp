@@ -248,7 +248,7 @@ std::string usage_text(const std::vector<ssao_param_desc>& table) {
   auto param_section = [&](const char* title, bool camera) {
     text += std::string("\n") + title + "\n";
     text += ssao_tools::param_help(table, [camera](const ssao_param_desc& desc) {
-      return ssao_tools::is_camera_param(desc.name) == camera;
+      return ssao_tools::is_camera_param(desc.name) == camera;  // the library's "camera" group
     });
   };
   param_section(

@@ -90,20 +90,40 @@ class Reader {
     fail(key, "must be one of " + join(choices) + ", got '" + value + "'");
   }
 
-  void matrix(const char* key, std::array<double, 16>& out) const {
+  // A rows x columns matrix (rows == 1: a flat array of `columns` numbers). A 4x4 one must be
+  // affine when it is a transform (matrix_world); a projection's last row is checked by the
+  // library.
+  void matrix(const char* key, std::vector<double>& out, size_t rows, size_t columns) const {
     const auto it = root_.find(key);
     if (it == root_.end()) return;
-    const char* const shape = "must be a 4x4 matrix: an array of 4 rows of 4 numbers";
-    if (!it->is_array() || it->size() != 4) fail(key, shape);
-    for (size_t row = 0; row < 4; ++row) {
+    const std::string shape =
+        rows == 1 ? "must be an array of " + std::to_string(columns) + " numbers"
+                  : "must be a " + std::to_string(rows) + "x" + std::to_string(columns) +
+                        " matrix: an array of " + std::to_string(rows) + " rows of " +
+                        std::to_string(columns) + " numbers";
+    const auto element = [&](const Json& array, size_t index, const std::string& name) {
+      return finite_number(array[index], name);
+    };
+    out.assign(rows * columns, 0.0);
+    if (rows == 1) {
+      if (!it->is_array() || it->size() != columns) fail(key, shape);
+      for (size_t col = 0; col < columns; ++col) {
+        out[col] = element(*it, col, std::string(key) + "[" + std::to_string(col) + "]");
+      }
+      return;
+    }
+    if (!it->is_array() || it->size() != rows) fail(key, shape);
+    for (size_t row = 0; row < rows; ++row) {
       const Json& r = (*it)[row];
-      if (!r.is_array() || r.size() != 4) fail(key, shape);
-      for (size_t col = 0; col < 4; ++col) {
-        out[row * 4 + col] = finite_number(r[col], std::string(key) + "[" + std::to_string(row) +
-                                                       "][" + std::to_string(col) + "]");
+      if (!r.is_array() || r.size() != columns) fail(key, shape);
+      for (size_t col = 0; col < columns; ++col) {
+        out[row * columns + col] = element(
+            r, col,
+            std::string(key) + "[" + std::to_string(row) + "][" + std::to_string(col) + "]");
       }
     }
-    if (out[12] != 0.0 || out[13] != 0.0 || out[14] != 0.0 || out[15] != 1.0) {
+    if (std::string(key) == "matrix_world" &&
+        (out[12] != 0.0 || out[13] != 0.0 || out[14] != 0.0 || out[15] != 1.0)) {
       fail(key, "must be an affine transform: its last row must be [0, 0, 0, 1]");
     }
   }
@@ -119,12 +139,105 @@ class Reader {
   const std::string& source_;
 };
 
-const std::vector<std::string>& known_keys() {
-  static const std::vector<std::string> keys = {
-      "type",         "lens",           "sensor_width",   "sensor_height", "sensor_fit",
-      "shift_x",      "shift_y",        "ortho_scale",    "clip_start",    "clip_end",
-      "matrix_world", "pixel_aspect_x", "pixel_aspect_y", "ao_distance"};
-  return keys;
+// A key of the file: the Camera member it fills, the library parameter it sets (nullptr: none),
+// and the check its value gets. The one list of the format's fields.
+enum class Check { any, positive, not_negative };
+struct NumberField {
+  const char* key;
+  double Camera::*member;
+  const char* param;
+  Check check;
+};
+struct ChoiceField {
+  const char* key;
+  std::string Camera::*member;
+  const char* param;
+  std::vector<std::string> choices;
+};
+struct MatrixField {
+  const char* key;
+  std::vector<double> Camera::*member;
+  const char* param;
+  size_t rows, columns;
+};
+
+const std::vector<ChoiceField>& choice_fields() {
+  static const std::vector<ChoiceField> fields = {
+      {"type", &Camera::type, "camera_type", {"PERSP", "ORTHO"}},
+      {"sensor_fit", &Camera::sensor_fit, "sensor_fit", {"AUTO", "HORIZONTAL", "VERTICAL"}},
+      {"projection", &Camera::projection, "projection", {"lens", "intrinsics", "matrix"}}};
+  return fields;
+}
+
+const std::vector<NumberField>& number_fields() {
+  static const std::vector<NumberField> fields = {
+      {"lens", &Camera::lens, "lens", Check::positive},
+      {"sensor_width", &Camera::sensor_width, "sensor_width", Check::positive},
+      {"sensor_height", &Camera::sensor_height, "sensor_height", Check::positive},
+      {"shift_x", &Camera::shift_x, "shift_x", Check::any},
+      {"shift_y", &Camera::shift_y, "shift_y", Check::any},
+      {"ortho_scale", &Camera::ortho_scale, "ortho_scale", Check::positive},
+      {"clip_start", &Camera::clip_start, "clip_start", Check::not_negative},
+      {"clip_end", &Camera::clip_end, "clip_end", Check::positive},
+      {"pixel_aspect_x", &Camera::pixel_aspect_x, "pixel_aspect_x", Check::positive},
+      {"pixel_aspect_y", &Camera::pixel_aspect_y, "pixel_aspect_y", Check::positive},
+      {"ao_distance", &Camera::ao_distance, nullptr, Check::positive}};
+  return fields;
+}
+
+const std::vector<MatrixField>& matrix_fields() {
+  static const std::vector<MatrixField> fields = {
+      {"matrix_world", &Camera::matrix_world, "camera_to_world", 4, 4},
+      {"intrinsics", &Camera::intrinsics, "intrinsics", 1, 4},
+      {"projection_matrix", &Camera::projection_matrix, "projection_matrix", 4, 4}};
+  return fields;
+}
+
+bool is_known_key(const std::string& key) {
+  for (const ChoiceField& f : choice_fields()) {
+    if (key == f.key) return true;
+  }
+  for (const NumberField& f : number_fields()) {
+    if (key == f.key) return true;
+  }
+  for (const MatrixField& f : matrix_fields()) {
+    if (key == f.key) return true;
+  }
+  return false;
+}
+
+// The "projection" key's value when it is a string ("lens" when absent; a wrong one is
+// reported by the choice check).
+std::string projection_of(const Json& root) {
+  const auto it = root.find("projection");
+  return it != root.end() && it->is_string() ? it->get<std::string>() : "lens";
+}
+
+// Only the keys this camera's projection reads are required (Blender's own rule for lens: AUTO
+// and HORIZONTAL fit sensor_width, VERTICAL fits sensor_height; ORTHO reads ortho_scale).
+void require_projection_keys(const Reader& read, const Camera& camera) {
+  if (camera.projection == "intrinsics") {
+    read.require("intrinsics", "fx, fy, cx, cy in pixels, which projection intrinsics needs");
+    return;
+  }
+  if (camera.projection == "matrix") {
+    read.require("projection_matrix",
+                 "the 4x4 view-to-clip matrix, which projection matrix "
+                 "needs");
+    return;
+  }
+  if (camera.type == "PERSP") {
+    read.require("lens", "the focal length in mm");
+    if (camera.sensor_fit == "VERTICAL") {
+      read.require("sensor_height", "the sensor height in mm, which a VERTICAL fit uses");
+    } else {
+      read.require("sensor_width", "the sensor width in mm");
+    }
+  } else {
+    read.require("ortho_scale", "the view's width in scene units, which an ORTHO camera needs");
+  }
+  read.require("shift_x", "the horizontal lens shift; 0 for none");
+  read.require("shift_y", "the vertical lens shift; 0 for none");
 }
 
 }  // namespace
@@ -145,50 +258,26 @@ Camera parse_camera_json(const std::string& text, const std::string& source) {
 
   Camera camera;
   const Reader read(root, source);
-  read.choice("type", camera.type, {"PERSP", "ORTHO"}, true);
-  read.choice("sensor_fit", camera.sensor_fit, {"AUTO", "HORIZONTAL", "VERTICAL"}, true);
-  read.number("lens", camera.lens);
-  read.number("sensor_width", camera.sensor_width);
-  read.number("sensor_height", camera.sensor_height);
-  read.number("shift_x", camera.shift_x);
-  read.number("shift_y", camera.shift_y);
-  read.number("ortho_scale", camera.ortho_scale);
-  read.number("clip_start", camera.clip_start);
-  read.number("clip_end", camera.clip_end);
-  read.number("pixel_aspect_x", camera.pixel_aspect_x);
-  read.number("pixel_aspect_y", camera.pixel_aspect_y);
-  read.matrix("matrix_world", camera.matrix_world);
-  camera.has_matrix_world = root.contains("matrix_world");
-  read.number("ao_distance", camera.ao_distance);
-  // Only the keys this camera's projection reads are required (Blender's own rule: AUTO and
-  // HORIZONTAL fit sensor_width, VERTICAL fits sensor_height; ORTHO reads ortho_scale instead).
-  if (camera.type == "PERSP") {
-    read.require("lens", "the focal length in mm");
-    if (camera.sensor_fit == "VERTICAL") {
-      read.require("sensor_height", "the sensor height in mm, which a VERTICAL fit uses");
-    } else {
-      read.require("sensor_width", "the sensor width in mm");
-    }
-  } else {
-    read.require("ortho_scale", "the view's width in scene units, which an ORTHO camera needs");
+  // "projection" (default lens) decides what else is required: "type" unless a matrix gives
+  // it, "sensor_fit" for Blender's lens and sensor.
+  const std::string projection = projection_of(root);
+  for (const ChoiceField& f : choice_fields()) {
+    const bool required = (f.member == &Camera::type && projection != "matrix") ||
+                          (f.member == &Camera::sensor_fit && projection == "lens");
+    read.choice(f.key, camera.*f.member, f.choices, required);
   }
-  read.require("shift_x", "the horizontal lens shift; 0 for none");
-  read.require("shift_y", "the vertical lens shift; 0 for none");
-  const std::pair<const char*, double> sizes[] = {{"lens", camera.lens},
-                                                  {"sensor_width", camera.sensor_width},
-                                                  {"sensor_height", camera.sensor_height},
-                                                  {"ortho_scale", camera.ortho_scale},
-                                                  {"clip_end", camera.clip_end},
-                                                  {"pixel_aspect_x", camera.pixel_aspect_x},
-                                                  {"pixel_aspect_y", camera.pixel_aspect_y},
-                                                  {"ao_distance", camera.ao_distance}};
-  for (const auto& [key, value] : sizes) read.positive(key, value);
-  read.not_negative("clip_start", camera.clip_start);
+  for (const NumberField& f : number_fields()) {
+    read.number(f.key, camera.*f.member);
+    if (f.check == Check::positive) read.positive(f.key, camera.*f.member);
+    if (f.check == Check::not_negative) read.not_negative(f.key, camera.*f.member);
+  }
+  for (const MatrixField& f : matrix_fields())
+    read.matrix(f.key, camera.*f.member, f.rows, f.columns);
+  camera.has_matrix_world = root.contains("matrix_world");
+  require_projection_keys(read, camera);
 
   for (const auto& item : root.items()) {
-    bool known = false;
-    for (const std::string& key : known_keys()) known = known || item.key() == key;
-    if (!known) camera.unknown_keys.push_back(item.key());
+    if (!is_known_key(item.key())) camera.unknown_keys.push_back(item.key());
   }
   return camera;
 }
@@ -206,42 +295,32 @@ Camera read_camera_json(const std::string& path) {
   return parse_camera_json(text.str(), path);
 }
 
-const std::vector<std::string>& camera_param_names() {
-  static const std::vector<std::string> names = {
-      "camera_type",    "lens",           "sensor_width",   "sensor_height", "sensor_fit",
-      "shift_x",        "shift_y",        "ortho_scale",    "clip_start",    "clip_end",
-      "pixel_aspect_x", "pixel_aspect_y", "camera_to_world"};
-  return names;
-}
-
 bool is_camera_param(const std::string& name) {
-  const auto& names = camera_param_names();
-  return std::find(names.begin(), names.end(), name) != names.end();
+  for (size_t i = 0; i < ssao_param_count(); ++i) {
+    ssao_param_desc desc;
+    if (ssao_param_info(i, &desc) == SSAO_OK && name == desc.name) {
+      return ssao::api::param_group(i) == "camera";
+    }
+  }
+  return false;
 }
 
 void apply_camera(ssao_job job, const Camera& camera, const std::string& source) {
   const std::string where = "camera file '" + source + "': ";
-  auto set_float = [&](const char* name, double value) {
-    ssao::api::check_status(ssao_job_set_float(job, name, value), where + name);
-  };
-  auto set_string = [&](const char* name, const std::string& value) {
-    ssao::api::check_status(ssao_job_set_string(job, name, value.c_str()), where + name);
-  };
-  set_string("camera_type", camera.type);
-  set_float("lens", camera.lens);
-  set_float("sensor_width", camera.sensor_width);
-  set_float("sensor_height", camera.sensor_height);
-  set_string("sensor_fit", camera.sensor_fit);
-  set_float("shift_x", camera.shift_x);
-  set_float("shift_y", camera.shift_y);
-  set_float("ortho_scale", camera.ortho_scale);
-  set_float("clip_start", camera.clip_start);
-  set_float("clip_end", camera.clip_end);
-  set_float("pixel_aspect_x", camera.pixel_aspect_x);
-  set_float("pixel_aspect_y", camera.pixel_aspect_y);
-  ssao::api::check_status(ssao_job_set_floats(job, "camera_to_world", camera.matrix_world.data(),
-                                              camera.matrix_world.size()),
-                          where + "matrix_world");
+  for (const ChoiceField& f : choice_fields()) {
+    ssao::api::check_status(ssao_job_set_string(job, f.param, (camera.*f.member).c_str()),
+                            where + f.key);
+  }
+  for (const NumberField& f : number_fields()) {
+    if (f.param == nullptr) continue;
+    ssao::api::check_status(ssao_job_set_float(job, f.param, camera.*f.member), where + f.key);
+  }
+  for (const MatrixField& f : matrix_fields()) {
+    const std::vector<double>& values = camera.*f.member;
+    if (values.empty()) continue;  // not in the file: the library's default
+    ssao::api::check_status(ssao_job_set_floats(job, f.param, values.data(), values.size()),
+                            where + f.key);
+  }
 }
 
 }  // namespace ssao_tools

@@ -13,11 +13,12 @@
 // absent), "clip_start" (informational), "clip_end" (depths at or beyond it are background;
 // absent: no such test, the depth pass marks its background itself), "ao_distance" (> 0, scene
 // units; Blender's World > Ambient Occlusion > Distance: the AO radius the shot was made for,
-// which the CLI uses when --radius is not given). Keys the format does not know are reported in
-// Camera::unknown_keys and otherwise ignored.
+// which the CLI uses when --radius is not given). Another renderer's camera: "projection":
+// "intrinsics" with "intrinsics": [fx, fy, cx, cy] (pixels; "type" still PERSP or ORTHO), or
+// "matrix" with "projection_matrix" (4x4, OpenGL view-to-clip); neither needs the lens keys.
+// Keys the format does not know are reported in Camera::unknown_keys and otherwise ignored.
 #pragma once
 
-#include <array>
 #include <string>
 #include <vector>
 
@@ -40,7 +41,13 @@ struct Camera {
   double pixel_aspect_x = 1.0;
   double pixel_aspect_y = 1.0;
   double ao_distance = 0.0;  // the AO radius chosen for this shot (scene units); 0: none given
-  std::array<double, 16> matrix_world = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
+  std::vector<double> matrix_world = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
+  // The library's camera contract beyond Blender's camera (ssao.h, "The camera"): "lens" (the
+  // keys above), "intrinsics" (fx, fy, cx, cy in pixels) or "matrix" (a 4x4 view-to-clip
+  // matrix). Empty: not in the file.
+  std::string projection = "lens";
+  std::vector<double> intrinsics;
+  std::vector<double> projection_matrix;
   bool has_matrix_world = false;          // the identity above is a placeholder, not the camera's
   std::vector<std::string> unknown_keys;  // present in the file, not part of the format
 };
@@ -55,12 +62,7 @@ Camera read_camera_json(const std::string& path);
 // Same from the text of a file; `source` names it in messages.
 Camera parse_camera_json(const std::string& text, const std::string& source);
 
-// The core parameters apply_camera() sets: camera_type, lens, sensor_width, sensor_height,
-// sensor_fit, shift_x, shift_y, ortho_scale, clip_start, clip_end, pixel_aspect_x,
-// pixel_aspect_y, camera_to_world.
-const std::vector<std::string>& camera_param_names();
-
-// True if `name` is one of camera_param_names().
+// True if `name` is a parameter of the library's "camera" group (ssao_param_group).
 bool is_camera_param(const std::string& name);
 
 // Sets the camera parameters of `job` through the C API. `source` (the file name) prefixes the

@@ -37,6 +37,14 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     check(std::isfinite(v), "a non-finite number accepted");
   }
   for (double v : camera.matrix_world) check(std::isfinite(v), "a non-finite matrix accepted");
+  check(camera.projection == "lens" || camera.projection == "intrinsics" ||
+            camera.projection == "matrix",
+        "unknown projection accepted");
+  check(camera.intrinsics.empty() || camera.intrinsics.size() == 4, "intrinsics not 4 values");
+  check(camera.projection_matrix.empty() || camera.projection_matrix.size() == 16,
+        "projection_matrix not 16 values");
+  for (double v : camera.intrinsics) check(std::isfinite(v), "non-finite intrinsics accepted");
+  for (double v : camera.projection_matrix) check(std::isfinite(v), "non-finite matrix accepted");
   check(camera.matrix_world[12] == 0.0 && camera.matrix_world[13] == 0.0 &&
             camera.matrix_world[14] == 0.0 && camera.matrix_world[15] == 1.0,
         "a non-affine matrix accepted");

@@ -478,7 +478,7 @@ ssao_ref::DepthScene reference_scene(const Scene& s) {
   if (!s.world_normal.empty()) {
     // World to view for normals: the inverse transpose of the world-to-camera linear part, that
     // is the transpose of camera_to_world's 3x3 (exact even if the camera is scaled).
-    const std::array<double, 16>& m = s.camera.matrix_world;  // row-major
+    const std::vector<double>& m = s.camera.matrix_world;  // row-major, 16 values
     d.view_normal.resize(s.world_normal.size());
     for (size_t p3 = 0; p3 < s.world_normal.size(); p3 += 3) {
       const double wx = s.world_normal[p3], wy = s.world_normal[p3 + 1],
