@@ -1,0 +1,96 @@
+// SPDX-License-Identifier: MIT
+#include "outputs.h"
+
+#include <cstdio>
+#include <filesystem>
+
+#include "ssao/ssao.hpp"
+
+namespace povray_ssao {
+namespace {
+
+std::vector<std::string> full_channel_names() { return {"R", "G", "B", "A", "AO", "Z", "Radial"}; }
+
+// The 8-bit preview: the composite's R, G, B (and A when the beauty had alpha).
+void write_preview(const Options& o, const AoInputs& in, const std::vector<float>& composite) {
+  const size_t count = in.frame_pixels();
+  const size_t channels = in.beauty_has_alpha ? 4 : 3;
+  std::vector<float> preview(count * channels);
+  for (size_t p = 0; p < count; ++p) {
+    for (size_t c = 0; c < channels; ++c) preview[p * channels + c] = composite[p * 4 + c];
+  }
+  std::vector<std::string> names = {"R", "G", "B", "A"};
+  names.resize(channels);
+  ssao_tools::write_preview(o.output, in.width, in.height, names, preview);
+}
+
+}  // namespace
+
+void write_outputs(const Options& o, const AoInputs& in, const std::vector<float>& composite,
+                   const std::vector<float>& ao) {
+  const size_t count = in.frame_pixels();
+  std::vector<float> full(count * 7);
+  for (size_t p = 0; p < count; ++p) {
+    for (size_t c = 0; c < 4; ++c) full[p * 7 + c] = composite[p * 4 + c];
+    full[p * 7 + 4] = ao[p];
+    full[p * 7 + 5] = in.planar[p];
+    full[p * 7 + 6] = in.radial[p];
+  }
+  auto write_main = [&]() {
+    if (ssao_tools::is_preview_path(o.output)) {
+      write_preview(o, in, composite);
+    } else {
+      ssao_tools::write_exr(o.output, in.width, in.height, full_channel_names(), full);
+    }
+  };
+  if (o.exr.empty()) {
+    write_main();
+    return;
+  }
+  ssao_tools::write_exr(o.exr, in.width, in.height, full_channel_names(), full);
+  try {
+    write_main();
+  } catch (...) {
+    std::error_code ec;
+    std::filesystem::remove(o.exr, ec);
+    throw;
+  }
+}
+
+void write_depth_only(const Options& o, const AoInputs& in) {
+  const size_t count = in.frame_pixels();
+  std::vector<float> pixels(count * 2);
+  for (size_t p = 0; p < count; ++p) {
+    pixels[p * 2] = in.planar[p];
+    pixels[p * 2 + 1] = in.radial[p];
+  }
+  ssao_tools::write_exr(o.output, in.width, in.height, {"Z", "Radial"}, pixels);
+}
+
+void print_camera(const CameraReading& reading, int width, int height, int band) {
+  std::printf("camera: %s\n  read from %s\n", reading.camera.summary().c_str(),
+              reading.source.c_str());
+  if (band > 0) {
+    std::printf("the beauty and the ambient pass are rendered with (after the scene):\n%s",
+                reading.camera.to_sdl().c_str());
+    std::printf("the depth and normal passes, %dx%d with a %d-pixel guard band, with:\n%s",
+                width + 2 * band, height + 2 * band, band,
+                reading.camera.widened(width, height, band).to_sdl().c_str());
+  } else {
+    std::printf("every pass is rendered with (after the scene):\n%s",
+                reading.camera.to_sdl().c_str());
+  }
+  ssao::api::Job job;
+  reading.camera.apply_to_job(job, width, height);
+  if (reading.camera.orthographic) {
+    std::printf("libssao (%dx%d): camera_type ORTHO, ortho_scale %.9g", width, height,
+                job.get_float("ortho_scale"));
+  } else {
+    std::printf("libssao (%dx%d): camera_type PERSP, lens %.9g mm, sensor_width 36 mm", width,
+                height, job.get_float("lens"));
+  }
+  std::printf(", sensor_fit HORIZONTAL, pixel_aspect %.9g:%.9g\n", job.get_float("pixel_aspect_x"),
+              job.get_float("pixel_aspect_y"));
+}
+
+}  // namespace povray_ssao

@@ -1,0 +1,26 @@
+// SPDX-License-Identifier: MIT
+// What povray-ssao writes: the output files of an image (-o, --exr), the depth of --depth-only,
+// and the camera report of --print-camera.
+#pragma once
+
+#include <vector>
+
+#include "ao_inputs.h"
+#include "options.h"
+#include "pov_camera.h"
+
+namespace povray_ssao {
+
+// Writes -o (and --exr): an 8-bit sRGB preview of the composite, or every channel as float EXR
+// (R, G, B, A, AO, Z, Radial). If the second file cannot be written the first is removed again.
+void write_outputs(const Options& o, const AoInputs& in, const std::vector<float>& composite,
+                   const std::vector<float>& ao);
+
+// --depth-only: the frame's Z and Radial channels to -o.
+void write_depth_only(const Options& o, const AoInputs& in);
+
+// --print-camera: the camera read, the camera blocks the passes are rendered with, and libssao's
+// camera parameters, on stdout.
+void print_camera(const CameraReading& reading, int width, int height, int band);
+
+}  // namespace povray_ssao

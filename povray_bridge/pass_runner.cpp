@@ -1,0 +1,88 @@
+// SPDX-License-Identifier: MIT
+#include "pass_runner.h"
+
+#include <cstdio>
+#include <filesystem>
+
+#include "tools/error.h"
+
+namespace povray_ssao {
+
+namespace fs = std::filesystem;
+
+std::string PassRunner::output(const std::string& name) const {
+  return scratch->file(name + (frame ? frame->digits : "") + ".exr");
+}
+
+RunningPass PassRunner::start(const std::string& what, const std::string& name,
+                              const std::string& wrapper, int width, int height,
+                              const std::vector<std::string>& extra) const {
+  RunningPass pass;
+  pass.what = what;
+  pass.output = output(name);
+  pass.log = scratch->file(name + ".log");
+  std::vector<std::string> args = user_options;
+  if (frame) {
+    args.push_back("+SF" + std::to_string(frame->number));
+    args.push_back("+EF" + std::to_string(frame->number));
+  }
+  args.push_back("+I" + scratch->file(wrapper));
+  args.push_back("+O" + scratch->file(name + ".exr"));
+  args.push_back("+W" + std::to_string(width));
+  args.push_back("+H" + std::to_string(height));
+  args.push_back("-D");
+  args.push_back("-P");
+  args.push_back("+FE");
+  args.push_back("+L" + scene_folder);
+  args.push_back("+L" + include_folder);
+  args.insert(args.end(), extra.begin(), extra.end());
+  // The log starts with the command, so that a kept log can be rerun by hand.
+  if (FILE* file = std::fopen(pass.log.c_str(), "w")) {
+    std::fprintf(file, "povray-ssao: %s", executable.c_str());
+    for (const std::string& arg : args) std::fprintf(file, " %s", arg.c_str());
+    std::fprintf(file, "\n(in %s)\n\n", scene_folder.c_str());
+    std::fclose(file);
+  }
+  pass.process =
+      std::make_unique<RunningProcess>(executable, args, scene_folder, pass.log, pass.output);
+  return pass;
+}
+
+double PassRunner::finish(RunningPass& pass) const {
+  // The image is complete once POV-Ray closes it; its shutdown after that is not waited for.
+  const RenderResult result = pass.process->wait_for_output();
+  if (result.output_written) return result.seconds;
+  std::error_code ec;
+  if (result.exit_status == 0 && fs::is_regular_file(pass.output, ec)) return result.seconds;
+  std::string message = "POV-Ray failed on the " + pass.what;
+  message += result.exit_status != 0 ? " (exit status " + std::to_string(result.exit_status) + ")"
+                                     : " (no image written)";
+  message += ". Its last messages:\n" + povray_error_lines(pass.log);
+  if (!keep) message += "(--keep DIR keeps the wrappers and the full logs)";
+  while (!message.empty() && message.back() == '\n') message.pop_back();
+  throw ssao_tools::Error(message);
+}
+
+double PassRunner::render(const std::string& what, const std::string& name,
+                          const std::string& wrapper, int width, int height,
+                          const std::vector<std::string>& extra) const {
+  RunningPass running = start(what, name, wrapper, width, height, extra);
+  return finish(running);
+}
+
+KeepFiles::~KeepFiles() {
+  if (target_.empty()) return;
+  std::error_code ec;
+  for (const auto& entry : fs::directory_iterator(scratch_.path(), ec)) {
+    fs::copy_file(entry.path(), fs::path(target_) / entry.path().filename(),
+                  fs::copy_options::overwrite_existing, ec);
+    if (ec) {
+      report_.warning("--keep: cannot copy " + entry.path().filename().string() + " to " +
+                      in_quotes(target_) + ": " + ec.message());
+      return;
+    }
+  }
+  report_.progress("kept the wrappers, logs and passes in %s", target_.c_str());
+}
+
+}  // namespace povray_ssao

@@ -1,0 +1,64 @@
+// SPDX-License-Identifier: MIT
+// The povray runs of one image (a still or one animation frame): each pass renders a wrapper
+// scene from the scratch folder, in the scene's folder, with the user's options and its own,
+// into <name>.exr with its log beside it. --keep copies them all when the image is done.
+#pragma once
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "animation.h"
+#include "povray_run.h"
+#include "reporter.h"
+
+namespace povray_ssao {
+
+// A povray run under way: what it renders, where its image and log go.
+struct RunningPass {
+  std::string what;  // "depth pass", for messages
+  std::string output, log;
+  std::unique_ptr<RunningProcess> process;  // null: not started
+};
+
+struct PassRunner {
+  std::string executable;
+  std::string scene_folder;
+  std::string include_folder;
+  std::vector<std::string> user_options;  // --ini and the pass-through options, in order
+  const ScratchFolder* scratch = nullptr;
+  bool keep = false;
+  const AnimationFrame* frame = nullptr;  // an animation's frame: rendered alone (+SF +EF)
+
+  // Where POV-Ray writes +O<name>.exr: an animation frame's number goes before the extension.
+  std::string output(const std::string& name) const;
+
+  // Starts rendering `wrapper` to output(name); finish() waits for it.
+  RunningPass start(const std::string& what, const std::string& name, const std::string& wrapper,
+                    int width, int height, const std::vector<std::string>& extra) const;
+
+  // Waits for the run; returns its wall-clock seconds. Throws with POV-Ray's own messages when
+  // it failed or wrote no image.
+  double finish(RunningPass& pass) const;
+
+  // start() and finish().
+  double render(const std::string& what, const std::string& name, const std::string& wrapper,
+                int width, int height, const std::vector<std::string>& extra) const;
+};
+
+// Copies the scratch folder's files to --keep DIR when it goes out of scope (also on failure).
+class KeepFiles {
+ public:
+  KeepFiles(const ScratchFolder& scratch, std::string target, const Reporter& report)
+      : scratch_(scratch), target_(std::move(target)), report_(report) {}
+  ~KeepFiles();
+  KeepFiles(const KeepFiles&) = delete;
+  KeepFiles& operator=(const KeepFiles&) = delete;
+
+ private:
+  const ScratchFolder& scratch_;
+  std::string target_;
+  const Reporter& report_;
+};
+
+}  // namespace povray_ssao

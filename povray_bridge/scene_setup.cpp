@@ -1,0 +1,214 @@
+// SPDX-License-Identifier: MIT
+#include "scene_setup.h"
+
+#include <unistd.h>
+
+#include <cstdlib>
+#include <vector>
+
+#include "povray_run.h"
+#include "reporter.h"
+#include "tools/files.h"
+
+#ifndef POVRAY_SSAO_SOURCE_INCLUDES
+#define POVRAY_SSAO_SOURCE_INCLUDES ""
+#endif
+
+namespace povray_ssao {
+namespace {
+
+namespace fs = std::filesystem;
+
+// The folder of the shipped includes: next to the binary (<bin>/../share/povray-ssao), else
+// the source tree's povray_bridge/pov.
+std::string include_folder() {
+  std::vector<fs::path> candidates;
+  std::error_code ec;
+  const fs::path self = fs::read_symlink("/proc/self/exe", ec);
+  if (!ec) candidates.push_back(self.parent_path().parent_path() / "share" / "povray-ssao");
+  if (*POVRAY_SSAO_SOURCE_INCLUDES) candidates.emplace_back(POVRAY_SSAO_SOURCE_INCLUDES);
+  std::string tried;
+  for (const fs::path& candidate : candidates) {
+    if (fs::is_regular_file(candidate / "ssao_depth_post.inc", ec) &&
+        fs::is_regular_file(candidate / "ssao_depth_pre.inc", ec) &&
+        fs::is_regular_file(candidate / "ssao_ambient_post.inc", ec)) {
+      return fs::absolute(candidate).lexically_normal().string();
+    }
+    tried += (tried.empty() ? "" : ", ") + in_quotes(candidate.string());
+  }
+  throw ssao_tools::Error(
+      "cannot find povray-ssao's include files ssao_depth_pre.inc, "
+      "ssao_depth_post.inc and ssao_ambient_post.inc (looked in " +
+      tried + ")");
+}
+
+// The scene must be a readable file.
+void check_scene(const Options& o) {
+  std::error_code ec;
+  if (!fs::exists(o.scene, ec)) throw ssao_tools::Error("no scene file " + in_quotes(o.scene));
+  if (!fs::is_regular_file(o.scene, ec)) {
+    throw ssao_tools::Error("the scene " + in_quotes(o.scene) + " is not a file");
+  }
+  if (::access(o.scene.c_str(), R_OK) != 0) {
+    throw ssao_tools::Error("cannot read the scene file " + in_quotes(o.scene));
+  }
+}
+
+// The outputs, --ini and --keep: refused now rather than after the rendering.
+void check_outputs_and_folders(const Options& o) {
+  std::error_code ec;
+  if (!o.print_camera) {
+    ssao_tools::check_output_folder(o.output);
+    if (!o.exr.empty()) ssao_tools::check_output_folder(o.exr);
+    if (ssao_tools::same_file(o.output, o.scene) ||
+        (!o.exr.empty() && ssao_tools::same_file(o.exr, o.scene))) {
+      throw UsageError("the output is the scene file; choose another -o");
+    }
+  }
+  if (!o.ini.empty() && !fs::is_regular_file(o.ini, ec)) {
+    throw ssao_tools::Error("no INI file " + in_quotes(o.ini));
+  }
+  if (!o.keep.empty()) {
+    fs::create_directories(o.keep, ec);
+    if (!fs::is_directory(o.keep, ec)) {
+      throw ssao_tools::Error("--keep: cannot create the folder " + in_quotes(o.keep));
+    }
+  }
+}
+
+// The size POV-Ray will render: the command line's, else the INI file's, else povray.ini's, else
+// its built-in 160x120. Throws when it is over povray-ssao's limit.
+void frame_size(const Options& o, const std::string& scene_folder, int& width, int& height) {
+  width = o.width;
+  height = o.height;
+  if (!o.ini.empty() && (width == 0 || height == 0)) {
+    int w = 0, h = 0;
+    ini_size(o.ini, w, h);
+    if (width == 0) width = w;
+    if (height == 0) height = h;
+  }
+  default_size(scene_folder, width, height);
+  if (width > kMaxSide || height > kMaxSide || double(width) * double(height) > kMaxPixels) {
+    throw ssao_tools::Error("the image size " + std::to_string(width) + "x" +
+                            std::to_string(height) + " is over povray-ssao's limit of " +
+                            "67108864 pixels (8192 x 8192, about 4 GB of passes)");
+  }
+}
+
+// Where POV-Ray looks for include files, in its order: povray.ini's and --ini's Library_Path,
+// the command line's +L, the scene's folder, povray-ssao's includes (relative to the scene).
+std::vector<std::string> library_paths(const Options& o, const std::string& startup_ini,
+                                       const std::string& scene_folder,
+                                       const std::string& includes) {
+  std::vector<std::string> paths;
+  if (!startup_ini.empty()) ini_library_paths(startup_ini, paths);
+  if (!o.ini.empty()) ini_library_paths(o.ini, paths);
+  for (const std::string& option : o.povray_options) {
+    if (option.size() > 2 && (option[1] == 'L' || option[1] == 'l')) {
+      paths.push_back(option.substr(2));
+    } else if (option.size() > 13 &&
+               (option.rfind("Library_Path=", 0) == 0 || option.rfind("library_path=", 0) == 0)) {
+      paths.push_back(option.substr(13));
+    }
+  }
+  paths.push_back(scene_folder);
+  paths.push_back(includes);
+  for (std::string& path : paths) {
+    if (fs::path(path).is_relative()) path = (fs::path(scene_folder) / path).string();
+  }
+  return paths;
+}
+
+// The Declare=NAME=VALUE settings of povray.ini, --ini and the command line, as the numbers the
+// scan knows (POV-Ray's Declare= takes floats only); reads the clock options on the way.
+Symbols declared_values(const Options& o, const std::string& startup_ini, ClockOptions& clock) {
+  std::vector<std::string> declares;
+  if (!startup_ini.empty()) ini_declares(startup_ini, declares, clock);
+  if (!o.ini.empty()) ini_declares(o.ini, declares, clock);
+  option_declares(o.povray_options, declares, clock);
+  Symbols symbols;
+  for (const std::string& declare : declares) {
+    const size_t equals = declare.find('=');
+    Symbol symbol;
+    symbol.kind = Symbol::kValue;
+    symbol.declared_at = "Declare=" + declare;
+    char* end = nullptr;
+    symbol.value.v.x = std::strtod(declare.c_str() + equals + 1, &end);
+    if (equals != std::string::npos && end && *end == '\0') {
+      symbols[declare.substr(0, equals)] = symbol;
+    }
+  }
+  return symbols;
+}
+
+}  // namespace
+
+RenderSetup prepare_render(const Options& o) {
+  check_scene(o);
+  RenderSetup setup;
+  setup.scene_path = fs::absolute(o.scene).lexically_normal();
+  setup.scene_folder = setup.scene_path.parent_path().string();
+  setup.scene_name = setup.scene_path.filename().string();
+  if (setup.scene_name.find('"') != std::string::npos) {
+    throw ssao_tools::Error(
+        "the scene's file name contains '\"', which POV-Ray's #include cannot "
+        "take");
+  }
+  check_outputs_and_folders(o);
+  frame_size(o, setup.scene_folder, setup.width, setup.height);
+  guard_band(o, setup.width, setup.height);  // a band too large is every frame's mistake
+
+  // The camera is read from the scene text and its include files, found as POV-Ray finds them.
+  setup.includes = include_folder();
+  const std::string startup_ini = system_ini(setup.scene_folder);
+  ScanSettings& settings = setup.settings;
+  settings.directory = setup.scene_folder;
+  settings.library_paths = library_paths(o, startup_ini, setup.scene_folder, setup.includes);
+  settings.image_width = setup.width;
+  settings.image_height = setup.height;
+  settings.predeclared = declared_values(o, startup_ini, setup.clock);
+  settings.clock = setup.clock.clock;
+  return setup;
+}
+
+int guard_band(const Options& o, int width, int height) {
+  if (o.depth_only) return 0;
+  auto fits = [&](int band) {
+    const long long data_width = static_cast<long long>(width) + 2LL * band;
+    const long long data_height = static_cast<long long>(height) + 2LL * band;
+    return band >= 0 && data_width <= kMaxSide && data_height <= kMaxSide &&
+           double(data_width) * double(data_height) <= kMaxPixels;
+  };
+  if (!o.overscan) {
+    // The default shrinks near the size limits rather than refusing a frame that fits.
+    int band = default_guard_band(width, height);
+    while (band > 0 && !fits(band)) --band;
+    return band;
+  }
+  const int band = *o.overscan;
+  if (!fits(band)) {
+    const long long data_width = static_cast<long long>(width) + 2LL * band;
+    const long long data_height = static_cast<long long>(height) + 2LL * band;
+    throw ssao_tools::Error(
+        "--overscan " + std::to_string(band) + ": the data passes would be " +
+        std::to_string(data_width) + "x" + std::to_string(data_height) +
+        ", over povray-ssao's limit of 65536 pixels a side and 67108864 pixels (8192 x 8192); "
+        "choose a smaller band");
+  }
+  return band;
+}
+
+ImageScene read_image_scene(const Options& o, const RenderSetup& setup,
+                            const AnimationFrame* frame) {
+  ScanSettings settings = setup.settings;
+  if (frame) {
+    settings.clock = frame->clock;
+    declare_frame(setup.clock, *frame, settings.predeclared);
+  }
+  ImageScene scene;
+  scene.scan = scan_scene(setup.scene_path.string(), settings);
+  scene.reading = read_camera(scene.scan, o.camera, setup.width, setup.height);
+  return scene;
+}
+
+}  // namespace povray_ssao

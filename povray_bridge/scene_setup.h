@@ -1,0 +1,52 @@
+// SPDX-License-Identifier: MIT
+// The render mode's setup: what is checked before POV-Ray runs (the scene, the outputs, the
+// size, the guard band), what every image of a render shares (RenderSetup), and the scene as
+// one image sees it (scanned at its clock, its camera read).
+#pragma once
+
+#include <filesystem>
+#include <string>
+
+#include "animation.h"
+#include "options.h"
+#include "pov_camera.h"
+#include "sdl.h"
+
+namespace povray_ssao {
+
+// POV-Ray would render a size this large for hours before anything failed; each of the passes,
+// the AO buffers and the outputs hold it as float (about 64 bytes a pixel in all).
+constexpr double kMaxPixels = 8192.0 * 8192.0;
+constexpr int kMaxSide = 65536;
+
+// What every image of a render shares: the scene, the size, the scan settings, the clock.
+struct RenderSetup {
+  std::filesystem::path scene_path;
+  std::string scene_folder, scene_name;
+  std::string includes;  // the folder of povray-ssao's shipped include files
+  int width = 0, height = 0;
+  ScanSettings settings;
+  ClockOptions clock;
+};
+
+// Checks the scene file, the outputs, --ini, --keep and the image size, and gathers what the
+// scan needs: the library paths and Declare= values POV-Ray will see. Throws ssao_tools::Error
+// (UsageError for an output that is the scene) before anything is rendered.
+RenderSetup prepare_render(const Options& o);
+
+// The guard band of the data passes (pixels per side): --overscan, else the default; none for
+// --depth-only (the frame's depth is its output). Throws when --overscan would take the data
+// passes over the size limits.
+int guard_band(const Options& o, int width, int height);
+
+// The scene as one image (a still, or an animation's frame) sees it.
+struct ImageScene {
+  SceneScan scan;
+  CameraReading reading;
+};
+
+// Scans the scene text at the frame's clock and reads its camera (with the --camera-* flags).
+ImageScene read_image_scene(const Options& o, const RenderSetup& setup,
+                            const AnimationFrame* frame);
+
+}  // namespace povray_ssao
