@@ -24,9 +24,22 @@ EEVEE_BACKGROUND_DEPTH = 65504.0
 
 # The library parameters the node exposes, by their library names (the rest are set here:
 # camera, conventions, threads).
-NODE_PARAMETERS = ("variant", "radius", "quality", "resolution", "samples", "slices", "steps",
-                   "bias", "thickness", "sample_clustering", "sphere_mode", "denoise", "strength",
-                   "power", "remap_min", "remap_max", "seed")
+# The library's parameter groups (ssao_param_group) the node shows: every parameter that
+# changes the look. The input, camera and execution groups the add-on sets itself.
+NODE_GROUPS = ("ao", "quality", "shaping")
+_node_parameter_names = None
+
+
+def node_parameter_names():
+    """The names of the library's parameters the node shows, in the table's order."""
+    global _node_parameter_names
+    if _node_parameter_names is None:
+        try:
+            table = ssao_native.parameters(library())
+        except Exception:  # no library: the node shows its error, a .blend still saves
+            return ()
+        _node_parameter_names = tuple(p["name"] for p in table if p["group"] in NODE_GROUPS)
+    return _node_parameter_names
 
 # The node's own settings (not library parameters): what the add-on renders for the library
 # beyond the user's passes (hidden_surfaces.py). Saved with the node's parameters.
@@ -123,7 +136,7 @@ def read_export(path):
 
 
 def node_parameters(node):
-    return {name: getattr(node, name) for name in NODE_PARAMETERS if hasattr(node, name)}
+    return {name: getattr(node, name) for name in node_parameter_names() if hasattr(node, name)}
 
 
 def node_settings(node):

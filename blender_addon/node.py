@@ -4,7 +4,6 @@ whose properties are libssao's parameters, with the library's names, defaults an
 import bpy
 
 from . import compat, compute, handlers, inner_tree, recomposite, ssao_native
-from .compute import NODE_PARAMETERS
 
 # Why the library's parameter table could not be read (shown on the node), or None.
 LIBRARY_ERROR = None
@@ -51,7 +50,7 @@ def _parameter_table():
     except Exception as error:  # the node must still register so .blend files open
         LIBRARY_ERROR = str(error)
         return {}
-    return {name: table[name] for name in NODE_PARAMETERS if name in table}
+    return {name: table[name] for name in compute.node_parameter_names()}
 
 
 class CompositorNodeSSAO(bpy.types.CompositorNodeCustomGroup):
@@ -104,10 +103,11 @@ class CompositorNodeSSAO(bpy.types.CompositorNodeCustomGroup):
     def draw_buttons(self, context, layout):
         if LIBRARY_ERROR:
             layout.label(text="libssao missing (see console)", icon='ERROR')
+        shown = set(compute.node_parameter_names()) if not LIBRARY_ERROR else set()
         variant_specific = set().union(*VARIANT_PARAMETERS.values())
         active = VARIANT_PARAMETERS.get(getattr(self, "variant", ""), variant_specific)
         for name in self.bl_rna.properties.keys():
-            if name in NODE_PARAMETERS and (name not in variant_specific or name in active):
+            if name in shown and (name not in variant_specific or name in active):
                 layout.prop(self, name)
         for name in compute.NODE_SETTINGS:
             layout.prop(self, name)
