@@ -4,7 +4,6 @@
 #include <string>
 #include <vector>
 
-#include "tools/camera_json.h"
 #include "tools/frames.h"
 
 namespace ssao_cli {
@@ -245,20 +244,23 @@ std::string usage_text(const std::vector<ssao_param_desc>& table) {
     }
   }
 
-  auto param_section = [&](const char* title, bool camera) {
+  // The library's parameters, a section per group (ssao_param_group), in the table's order.
+  const auto param_section = [&](const char* group, const char* title) {
     text += std::string("\n") + title + "\n";
-    text += ssao_tools::param_help(table, [camera](const ssao_param_desc& desc) {
-      return ssao_tools::is_camera_param(desc.name) == camera;  // the library's "camera" group
-    });
+    size_t index = 0;
+    text += ssao_tools::param_help(
+        table, [&](const ssao_param_desc&) { return ssao::api::param_group(index++) == group; });
   };
-  param_section(
-      "AO parameters (libssao's parameter table; --NAME_WITH_UNDERSCORES is written "
-      "with dashes):",
-      false);
-  param_section(
-      "Camera parameters (set from --camera CAM.json, matrix_world giving\n"
-      "camera_to_world; a flag given here overrides the file):",
-      true);
+  param_section("ao",
+                "AO parameters (libssao's parameter table; --NAME_WITH_UNDERSCORES is written "
+                "with dashes):");
+  param_section("quality", "Quality parameters (how much work: time against noise):");
+  param_section("shaping", "Shaping parameters (the final look of the AO):");
+  param_section("input", "Input conventions (how the passes are read):");
+  param_section("camera",
+                "Camera parameters (set from --camera CAM.json, matrix_world giving\n"
+                "camera_to_world; a flag given here overrides the file):");
+  param_section("execution", "Execution (results do not depend on it):");
 
   text +=
       "\n"
