@@ -50,22 +50,6 @@ void report_camera(const ImageScene& scene, int width, int height, const Reporte
   }
 }
 
-// povray runs in the scene's folder with the user's --ini and options, an animation frame alone.
-PassRunner pass_runner(const Options& o, const RenderSetup& setup, const AnimationFrame* frame,
-                       const ScratchFolder& scratch) {
-  PassRunner povray;
-  povray.executable = find_executable(o.povray);
-  povray.scene_folder = setup.scene_folder;
-  povray.include_folder = setup.includes;
-  if (!o.ini.empty()) povray.user_options.push_back(fs::absolute(o.ini).string());
-  povray.user_options.insert(povray.user_options.end(), o.povray_options.begin(),
-                             o.povray_options.end());
-  povray.scratch = &scratch;
-  povray.frame = frame;
-  povray.keep = !o.keep.empty();
-  return povray;
-}
-
 // One image (a still, or one frame of an animation): the passes, AO and the outputs.
 void render_image(const Options& o, const RenderSetup& setup, const AnimationFrame* frame,
                   const Reporter& report) {
@@ -78,7 +62,7 @@ void render_image(const Options& o, const RenderSetup& setup, const AnimationFra
       throw ssao_tools::Error("--keep: cannot create the folder " + in_quotes(o.keep));
     }
   }
-  const ImageScene scene = read_image_scene(o, setup, frame);
+  const ImageScene scene = read_image_scene(o, setup, frame, report);
   const CameraReading& reading = scene.reading;
   const int band = guard_band(o, width, height);
   if (o.print_camera) {
@@ -90,7 +74,7 @@ void render_image(const Options& o, const RenderSetup& setup, const AnimationFra
   report_camera(scene, width, height, report);
 
   ScratchFolder scratch;
-  const PassRunner povray = pass_runner(o, setup, frame, scratch);
+  const PassRunner povray = make_pass_runner(o, setup, frame, scratch);
   KeepFiles keep(scratch, o.keep, report);
   // The data passes libssao reads (depth, normals) see a band around the frame: occluders just
   // outside it darken its edges. The beauty and the ambient pass are the frame.

@@ -54,6 +54,12 @@ double PassRunner::finish(RunningPass& pass) const {
   if (result.output_written) return result.seconds;
   std::error_code ec;
   if (result.exit_status == 0 && fs::is_regular_file(pass.output, ec)) return result.seconds;
+  const std::string parse_error = povray_parse_error(pass.log);
+  if (!parse_error.empty()) {
+    // POV-Ray's own diagnosis says it all: the file, the line and what is wrong.
+    throw ssao_tools::Error("POV-Ray cannot parse the scene (" + pass.what + "):\n  " +
+                            explain_parse_error(parse_error));
+  }
   std::string message = "POV-Ray failed on the " + pass.what;
   message += result.exit_status != 0 ? " (exit status " + std::to_string(result.exit_status) + ")"
                                      : " (no image written)";
@@ -61,6 +67,20 @@ double PassRunner::finish(RunningPass& pass) const {
   if (!keep) message += "(--keep DIR keeps the wrappers and the full logs)";
   while (!message.empty() && message.back() == '\n') message.pop_back();
   throw ssao_tools::Error(message);
+}
+
+std::string PassRunner::explain_parse_error(const std::string& error) const {
+  bool after_scene = error.rfind("File '" + scratch->path() + "/", 0) == 0;
+  for (const char* include : {"ssao_depth_post.inc", "ssao_ambient_post.inc"}) {
+    after_scene =
+        after_scene || error.rfind("File '" + include_folder + "/" + include + "'", 0) == 0;
+  }
+  const size_t line = error.find("' line ");
+  const size_t colon = line == std::string::npos ? line : error.find(": ", line);
+  if (!after_scene || colon == std::string::npos) return error;
+  return "File '" + scene_name + "', after its last line: " + error.substr(colon + 2) +
+         "\n  (POV-Ray reads on after the scene: it leaves a block or directive open, a missing } "
+         "or #end)";
 }
 
 double PassRunner::render(const std::string& what, const std::string& name,

@@ -24,6 +24,7 @@ struct RunningPass {
 struct PassRunner {
   std::string executable;
   std::string scene_folder;
+  std::string scene_name;  // the file the wrappers include, in scene_folder
   std::string include_folder;
   std::vector<std::string> user_options;  // --ini and the pass-through options, in order
   const ScratchFolder* scratch = nullptr;
@@ -38,8 +39,13 @@ struct PassRunner {
                     int width, int height, const std::vector<std::string>& extra) const;
 
   // Waits for the run; returns its wall-clock seconds. Throws with POV-Ray's own messages when
-  // it failed or wrote no image.
+  // it failed or wrote no image; POV-Ray's parse error when it could not parse the scene.
   double finish(RunningPass& pass) const;
+
+  // POV-Ray's parse error as the user needs it: one that POV-Ray reports after the scene's
+  // last line (in the wrapper or the include that follows the scene) is a block or directive
+  // the scene leaves open, so it is said to be at the end of the scene.
+  std::string explain_parse_error(const std::string& error) const;
 
   // start() and finish().
   double render(const std::string& what, const std::string& name, const std::string& wrapper,

@@ -40,6 +40,10 @@ constexpr double kAmbientScale = 10000.0;
 void write_wrappers(const std::string& folder, const std::string& scene_name,
                     const ResolvedCamera& camera, const ResolvedCamera& data_camera);
 
+// The wrapper of the parse check (scene_check.h), written into `folder`: the scene as POV-Ray
+// renders it (scene_camera.pov: no camera declared after the scene).
+void write_check_wrappers(const std::string& folder, const std::string& scene_name);
+
 // POV-Ray's Declare= options for the fog distances (and K).
 std::vector<std::string> fog_declares(const FogDistances& distances);
 

@@ -247,6 +247,28 @@ std::string povray_error_lines(const std::string& log_path, size_t max_lines) {
   return out;
 }
 
+std::string povray_parse_error(const std::string& log_path) {
+  // POV-Ray wraps its messages at 80 columns (anywhere between words, "Parse Error:" included);
+  // the continuation lines start with a space.
+  std::ifstream file(log_path);
+  std::vector<std::string> messages;
+  std::string line;
+  while (std::getline(file, line)) {
+    if (!messages.empty() && !line.empty() && line[0] == ' ') {
+      messages.back() += " " + trim(line);
+    } else {
+      messages.push_back(trim(line));
+    }
+  }
+  for (const std::string& message : messages) {
+    if (message.find("Parse Error:") != std::string::npos &&
+        message.find("Possible Parse Error:") == std::string::npos) {
+      return message;
+    }
+  }
+  return "";
+}
+
 namespace {
 
 // The lines POV-Ray reads from an INI file: comments (';') stripped, trimmed, empty lines

@@ -65,6 +65,11 @@ RenderResult run_process(const std::string& executable, const std::vector<std::s
 // `max_lines`), or its last lines when it has no recognisable error message.
 std::string povray_error_lines(const std::string& log_path, size_t max_lines = 15);
 
+// POV-Ray's parse error in a log: "File 'scene.pov' line 5: Parse Error: No matching } in
+// 'sphere', box found instead" (its wrapped lines joined; "Possible Parse Error" warnings
+// skipped), or "" when the log has none.
+std::string povray_parse_error(const std::string& log_path);
+
 // Width and height set by an INI file (Width=, Height=, +W, +H before the first [section]);
 // 0 for a value it does not set. Throws ssao_tools::Error if the file cannot be read.
 void ini_size(const std::string& path, int& width, int& height);

@@ -7,7 +7,7 @@
 #include <vector>
 
 #include "povray_run.h"
-#include "reporter.h"
+#include "scene_check.h"
 #include "tools/files.h"
 
 #ifndef POVRAY_SSAO_SOURCE_INCLUDES
@@ -198,16 +198,42 @@ int guard_band(const Options& o, int width, int height) {
   return band;
 }
 
-ImageScene read_image_scene(const Options& o, const RenderSetup& setup,
-                            const AnimationFrame* frame) {
+PassRunner make_pass_runner(const Options& o, const RenderSetup& setup, const AnimationFrame* frame,
+                            const ScratchFolder& scratch) {
+  PassRunner povray;
+  povray.executable = find_executable(o.povray);
+  povray.scene_folder = setup.scene_folder;
+  povray.scene_name = setup.scene_name;
+  povray.include_folder = setup.includes;
+  if (!o.ini.empty()) povray.user_options.push_back(fs::absolute(o.ini).string());
+  povray.user_options.insert(povray.user_options.end(), o.povray_options.begin(),
+                             o.povray_options.end());
+  povray.scratch = &scratch;
+  povray.frame = frame;
+  povray.keep = !o.keep.empty();
+  return povray;
+}
+
+ImageScene read_image_scene(const Options& o, const RenderSetup& setup, const AnimationFrame* frame,
+                            const Reporter& report) {
   ScanSettings settings = setup.settings;
   if (frame) {
     settings.clock = frame->clock;
     declare_frame(setup.clock, *frame, settings.predeclared);
   }
   ImageScene scene;
-  scene.scan = scan_scene(setup.scene_path.string(), settings);
-  scene.reading = read_camera(scene.scan, o.camera, setup.width, setup.height);
+  try {
+    scene.scan = scan_scene(setup.scene_path.string(), settings);
+    scene.reading = read_camera(scene.scan, o.camera, setup.width, setup.height);
+  } catch (const ssao_tools::Error&) {
+    // A syntax error often looks like a missing or unreadable camera to the scan: POV-Ray's
+    // own message says what is wrong, and where. --print-camera renders nothing.
+    if (!o.print_camera) {
+      ScratchFolder scratch;
+      check_scene_parses(make_pass_runner(o, setup, frame, scratch), setup.scene_name, report);
+    }
+    throw;
+  }
   return scene;
 }
 

@@ -9,7 +9,9 @@
 
 #include "animation.h"
 #include "options.h"
+#include "pass_runner.h"
 #include "pov_camera.h"
+#include "reporter.h"
 #include "sdl.h"
 
 namespace povray_ssao {
@@ -39,6 +41,11 @@ RenderSetup prepare_render(const Options& o);
 // passes over the size limits.
 int guard_band(const Options& o, int width, int height);
 
+// The runner of an image's povray runs: in the scene's folder, with the user's --ini and
+// options, an animation frame alone, the files in `scratch`.
+PassRunner make_pass_runner(const Options& o, const RenderSetup& setup, const AnimationFrame* frame,
+                            const ScratchFolder& scratch);
+
 // The scene as one image (a still, or an animation's frame) sees it.
 struct ImageScene {
   SceneScan scan;
@@ -46,7 +53,9 @@ struct ImageScene {
 };
 
 // Scans the scene text at the frame's clock and reads its camera (with the --camera-* flags).
-ImageScene read_image_scene(const Options& o, const RenderSetup& setup,
-                            const AnimationFrame* frame);
+// Where the text fails (a scan error, an unreadable camera), POV-Ray's parser is asked first,
+// so that a syntax error is reported as POV-Ray reports it (scene_check.h).
+ImageScene read_image_scene(const Options& o, const RenderSetup& setup, const AnimationFrame* frame,
+                            const Reporter& report);
 
 }  // namespace povray_ssao

@@ -1025,6 +1025,39 @@ box { -1 1 frobnicate }
         self.assertIn("Parse Error", proc.stderr, self.detail(proc))
         self.assertIn("broken.pov' line 5", proc.stderr, self.detail(proc))
 
+    def test_syntax_error_where_the_camera_is_read(self):
+        # Syntax errors that the camera scan trips over first (an unclosed block that swallows
+        # the camera, an unclosed comment, a broken camera), or that POV-Ray reports after the
+        # scene's last line (a block left open at its end, read on into povray-ssao's wrapper):
+        # the user must get POV-Ray's own diagnosis, in the scene's file, not "no camera".
+        camera = "camera { location <0, 1, -5> look_at 0 angle 50 }\n"
+        rest = "light_source { <5, 5, -5> rgb 1 }\nsphere { 0, 1 pigment { rgb 1 } }\n"
+        cases = [
+            ("#declare T = texture { pigment { rgb 1 }\n" + camera + rest,
+             ["File 'broken.pov' line 3: Parse Error: No matching } in 'texture', camera found"]),
+            ("/* a comment left open\n" + camera + rest,
+             ["File 'broken.pov' line ", "Parse Error: No */ closing comment found"]),
+            ("camera { location <0, 1, -5 look_at 0 angle 50 }\n" + rest,
+             ["File 'broken.pov' line 2: Parse Error: Expected '>', look_at found instead"]),
+            (camera + rest + "box { -1, 1\n",
+             ["File 'broken.pov', after its last line: Parse Error: No matching } in 'box'",
+              "a missing } or #end"]),
+            (rest + "box { -1, 1\n",  # no camera either
+             ["File 'broken.pov', after its last line: Parse Error: No matching } in 'box'"]),
+        ]
+        for text, phrases in cases:
+            with self.subTest(scene=text.splitlines()[0]):
+                scene = self.copy_scene("broken.pov", "#version 3.7;\n" + text)
+                out, exr = self.path("out.png"), self.path("out.exr")
+                proc = self.run_bridge(scene, "-o", out, "--exr", exr, "+W32", "+H24")
+                self.assert_fails(proc, outputs=[out, exr])
+                self.assertIn("povray-ssao: error: POV-Ray cannot parse the scene", proc.stderr,
+                              self.detail(proc))
+                for phrase in phrases:
+                    self.assertIn(phrase, proc.stderr, self.detail(proc))
+                self.assertNotIn("no camera", proc.stderr, self.detail(proc))
+                self.assertEqual(sorted(os.listdir(self.dir)), ["broken.pov"])
+
     def test_camera_inside_a_non_hollow_plane(self):
         # plane { z, 10 } behind the scene: the camera is inside its half-space, POV-Ray renders
         # no fog there and the depth pass would read the scene's colours as tiny depths. Both
