@@ -25,11 +25,10 @@ std::string describe(const FogDistances& d) {
   return out;
 }
 
-// Fog needs +Q9; antialiasing would mix depths across silhouettes.
-std::vector<std::string> DepthPass::options(const FogDistances& fogs) const {
+std::vector<std::string> depth_pass_options(const FogDistances& fogs, const SceneScan& scan) {
   std::vector<std::string> extra = {"+Q9", "-A", "-UA"};
   for (const std::string& d : fog_declares(fogs)) extra.push_back(d);
-  if (scan_.uses_radiosity) extra.push_back("Declare=SSAODepthCheapRadiosity=1");
+  if (scan.uses_radiosity) extra.push_back("Declare=SSAODepthCheapRadiosity=1");
   return extra;
 }
 
@@ -51,7 +50,7 @@ void DepthPass::run_prepass() {
       1, static_cast<int>(std::lround(static_cast<double>(pw) * data_height_ / data_width_)));
   report_.begin("depth-range pre-pass (%dx%d)... ", pw, ph);
   prepass_seconds = povray_.render("depth-range pre-pass", "prepass", "depth.pov", pw, ph,
-                                   options(prepass_distances()));
+                                   depth_pass_options(prepass_distances(), scan_));
   const ssao_tools::Image image = ssao_tools::read_image(povray_.output("prepass"));
   const DepthStats stats =
       depth_stats(decode_fog(image, prepass_distances(), povray_.output("prepass")));
@@ -69,7 +68,7 @@ void DepthPass::run_prepass() {
 
 void DepthPass::start() {
   running_ = povray_.start("depth pass", "depth", "depth.pov", data_width_, data_height_,
-                           options(distances_));
+                           depth_pass_options(distances_, scan_));
 }
 
 std::vector<float> DepthPass::read(std::vector<float>& precision) const {

@@ -41,7 +41,6 @@ class DepthPass {
   double seconds = 0.0;  // the depth pass's, both renders if there were two
 
  private:
-  std::vector<std::string> options(const FogDistances& fogs) const;
   void run_prepass();
   std::vector<float> read(std::vector<float>& precision) const;
   void report_depths(const DepthStats& depths, const DepthStats& errors) const;
@@ -57,6 +56,10 @@ class DepthPass {
   bool guessed_ = false;  // placed from the look_at distance (checked against the result)
   RunningPass running_;
 };
+
+// The options of a fog depth render: +Q9 (fog needs it), no antialiasing (it would mix depths
+// across silhouettes), the fogs, and the cheap radiosity for scenes that use radiosity.
+std::vector<std::string> depth_pass_options(const FogDistances& fogs, const SceneScan& scan);
 
 // "D1 = 25.2, D2 = 252"
 std::string describe(const FogDistances& d);

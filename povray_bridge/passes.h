@@ -40,9 +40,11 @@ constexpr double kAmbientScale = 10000.0;
 void write_wrappers(const std::string& folder, const std::string& scene_name,
                     const ResolvedCamera& camera, const ResolvedCamera& data_camera);
 
-// The wrapper of the parse check (scene_check.h), written into `folder`: the scene as POV-Ray
-// renders it (scene_camera.pov: no camera declared after the scene).
-void write_check_wrappers(const std::string& folder, const std::string& scene_name);
+// The wrappers of the default-camera check (scene_check.h), written into `folder`: the scene's
+// depth as POV-Ray renders it (scene_camera.pov: no camera declared after the scene) and with
+// `camera` declared after it (declared_camera.pov).
+void write_check_wrappers(const std::string& folder, const std::string& scene_name,
+                          const ResolvedCamera& camera);
 
 // POV-Ray's Declare= options for the fog distances (and K).
 std::vector<std::string> fog_declares(const FogDistances& distances);

@@ -734,9 +734,16 @@ CameraReading read_camera(const SceneScan& scan, const CameraOverrides& override
   CameraReading reading;
   std::string problem;
   if (scan.cameras.empty()) {
-    problem =
-        "found no camera { } block in the scene file or the include files it finds "
-        "(POV-Ray's SDL cannot report the camera, so povray-ssao reads it from the scene text)";
+    // POV-Ray renders a scene without a camera with its default one, which resolve() starts
+    // from (the flags apply on top of it, as on a scene's camera).
+    try {
+      reading.camera = resolve(Spec{}, overrides, reading.warnings);
+      reading.default_camera = true;
+      reading.source = "POV-Ray's default camera: the scene text has no camera { } block";
+      if (overrides.any()) reading.source += "; with the --camera-* flags";
+    } catch (const EvalError& e) {
+      problem = e.what();
+    }
   } else {
     const CameraSource& source = scan.cameras.back();
     try {

@@ -76,13 +76,16 @@ struct CameraReading {
   ResolvedCamera camera;
   std::string source;                 // "scene.pov:25", "--camera-* flags", ...
   bool had_focal_blur = false;        // the block sets a non-zero aperture (or may, under #if)
+  bool default_camera = false;        // the scene text has no camera: POV-Ray's default one
   std::vector<std::string> warnings;  // for the user
 };
 
-// The camera of a scan with the overrides applied on top. Throws ssao_tools::Error with a message
-// naming what could not be read and suggesting the --camera-* flags, when the camera is of
-// another type (fisheye, panoramic, ...), when an expression cannot be evaluated, or when no
-// camera block is found (unless the overrides are complete: location and look_at or direction).
+// The camera of a scan with the overrides applied on top. A scan without any camera gives
+// POV-Ray's default camera (perspective, location <0,0,0>, direction <0,0,1>, right
+// <1.33,0,0>, up <0,1,0>: looking along +z) with `default_camera` set. Throws
+// ssao_tools::Error with a message naming what could not be read and suggesting the --camera-*
+// flags, when the camera is of another type (fisheye, panoramic, ...) or when an expression
+// cannot be evaluated (unless the overrides are complete: location and look_at or direction).
 CameraReading read_camera(const SceneScan& scan, const CameraOverrides& overrides, int width,
                           int height);
 

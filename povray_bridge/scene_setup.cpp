@@ -234,6 +234,11 @@ ImageScene read_image_scene(const Options& o, const RenderSetup& setup, const An
     }
     throw;
   }
+  if (scene.reading.default_camera && !o.camera.any() && !o.print_camera) {
+    ScratchFolder scratch;
+    check_default_camera(make_pass_runner(o, setup, frame, scratch), setup.scene_name, scene.scan,
+                         scene.reading.camera, setup.width, setup.height, report);
+  }
   return scene;
 }
 

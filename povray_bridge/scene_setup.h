@@ -54,7 +54,8 @@ struct ImageScene {
 
 // Scans the scene text at the frame's clock and reads its camera (with the --camera-* flags).
 // Where the text fails (a scan error, an unreadable camera), POV-Ray's parser is asked first,
-// so that a syntax error is reported as POV-Ray reports it (scene_check.h).
+// so that a syntax error is reported as POV-Ray reports it; a scene without a camera gets
+// POV-Ray's default camera once POV-Ray is seen to render it with that (scene_check.h).
 ImageScene read_image_scene(const Options& o, const RenderSetup& setup, const AnimationFrame* frame,
                             const Reporter& report);
 

@@ -1317,6 +1317,65 @@ class PostProcessTest(PovTestCase):
         self.assertLess(float(ao[np.isfinite(dist)].mean()), 0.99)
 
 
+# POV-Ray 3.7's default camera (what it renders a scene without a camera with): perspective at the
+# origin, looking along +z, right 1.33 whatever the image's aspect.
+DEFAULT_CAMERA = ("camera { perspective location <0, 0, 0> direction <0, 0, 1> "
+                  "right <1.33, 0, 0> up <0, 1, 0> }\n")
+# In front of it: a sphere whose nearest point is 4 away on the view axis, on a floor, and a box.
+NO_CAMERA_SCENE = """#version 3.7;
+global_settings { assumed_gamma 1.0 }
+light_source { <3, 6, -4> rgb 1 }
+plane { y, -1 pigment { checker rgb 0.8 rgb 0.5 } }
+sphere { <0, 0, 5>, 1 pigment { rgb <0.9, 0.6, 0.4> } }
+box { <1.2, -1, 4>, <2.2, 0.5, 5> pigment { rgb 0.7 } }
+"""
+
+
+class DefaultCameraTest(PovTestCase):
+    """A scene without a camera: POV-Ray renders it with its default camera, and so must the
+    passes, after checking that POV-Ray does (a camera the scan cannot see must not be
+    replaced)."""
+
+    def test_no_camera_is_the_default_camera(self):
+        bare = self.copy_scene("bare.pov", NO_CAMERA_SCENE)
+        explicit = self.copy_scene("explicit.pov", NO_CAMERA_SCENE + DEFAULT_CAMERA)
+        proc, names, pixels, keep = self.bridge_exr(bare, "--radius", "0.5", name="bare")
+        self.assertIn("POV-Ray's default camera", proc.stdout, self.detail(proc))
+        self.assertIn("renders it with its default camera", proc.stdout, self.detail(proc))
+        _, explicit_names, explicit_pixels, _ = self.bridge_exr(explicit, "--radius", "0.5",
+                                                                name="explicit")
+        # The same camera, so the same passes, AO and composite (measured: identical).
+        self.assertEqual(names, explicit_names)
+        np.testing.assert_array_equal(pixels, explicit_pixels)
+        ao = channel(names, pixels, "AO")
+        self.assertLess(float(ao[np.isfinite(channel(names, pixels, "Z"))].mean()), 0.99)
+        # The beauty is POV-Ray's own render of the scene, and the camera looks along +z: the
+        # sphere's front is 4 away at the centre.
+        direct = read_image(self.povray(bare, self.path("direct.exr"), "+FE"))[1]
+        np.testing.assert_array_equal(read_image(os.path.join(keep, "beauty.exr"))[1], direct)
+        z = channel(names, pixels, "Z")
+        self.assertAlmostEqual(float(z[H // 2 - 1:H // 2 + 1, W // 2 - 1:W // 2 + 1].mean()), 4.0,
+                               delta=0.02)
+
+    def test_a_camera_the_scan_cannot_see_is_refused(self):
+        # A camera made by a macro: the text has no camera { } block the scan reads, yet POV-Ray
+        # renders another view than the default one. Declaring the default camera after the
+        # scene would silently replace it.
+        scene = self.copy_scene("macro.pov", NO_CAMERA_SCENE + """#macro MyCamera(L)
+  camera { location L look_at <0, 0, 5> angle 50 }
+#end
+MyCamera(<2, 3, -3>)
+""")
+        out, exr = self.path("out.png"), self.path("out.exr")
+        proc = self.run_bridge(scene, "-o", out, "--exr", exr, "+W32", "+H24")
+        self.assert_fails(proc, "another camera than its default one", "--camera-location",
+                          outputs=[out, exr])
+        # The flags give the camera: then the scene's own does not matter.
+        proc = self.run_bridge(scene, "-o", out, "+W32", "+H24", "--camera-location", "2,3,-3",
+                               "--camera-look-at", "0,0,5", "--camera-angle", "50")
+        self.assert_ok(proc, out)
+
+
 # ----------------------------------------------------------------------------------------------
 
 def main():
