@@ -29,17 +29,29 @@ namespace {
 namespace fs = std::filesystem;
 using ssao_tools::InterruptGuard;
 
+// The beauty and the ambient pass keep the scene's own camera when it has focal blur: POV-Ray
+// blurs them as the user asked, while the depth and normal passes, rendered with the resolved
+// camera, stay sharp (a blurred depth would mix distances). Camera flags replace the camera.
+bool scene_camera_for_frame(const Options& o, const CameraReading& reading) {
+  return reading.had_focal_blur && !o.camera.any();
+}
+
 // The camera's warnings, and what the passes cannot reproduce of it.
-void report_camera(const ImageScene& scene, int width, int height, const Reporter& report) {
+void report_camera(const Options& o, const ImageScene& scene, int width, int height,
+                   const Reporter& report) {
   const CameraReading& reading = scene.reading;
   report.progress("camera: %s (%s)", reading.camera.summary().c_str(), reading.source.c_str());
   for (const std::string& note : scene.scan.notes) report.warning(note);
   for (const std::string& warning : reading.warnings) report.warning(warning);
-  if (reading.had_focal_blur) {
+  if (scene_camera_for_frame(o, reading)) {
+    report.progress(
+        "focal blur: the beauty and the ambient pass keep the scene's camera and its blur; AO "
+        "comes from sharp depth%s passes, so it is sharp where the image is blurred",
+        scene.scan.includes_ssao_passes && !o.no_normals ? " and normal" : "");
+  } else if (reading.had_focal_blur) {
     report.warning(
-        "the scene's camera has focal blur (aperture); povray-ssao renders every "
-        "pass, the beauty included, without it (a blurred depth pass would be wrong, "
-        "and far slower)");
+        "the scene's camera has focal blur (aperture), which the --camera-* flags replace: "
+        "every pass, the beauty included, is rendered without it");
   }
   const double pixel_ratio =
       reading.camera.aspect() / (static_cast<double>(width) / static_cast<double>(height));
@@ -68,17 +80,18 @@ void render_image(const Options& o, const RenderSetup& setup, const AnimationFra
   if (o.print_camera) {
     for (const std::string& note : scene.scan.notes) report.warning(note);
     for (const std::string& warning : reading.warnings) report.warning(warning);
-    print_camera(reading, width, height, band);
+    print_camera(reading, scene_camera_for_frame(o, reading), width, height, band);
     return;
   }
-  report_camera(scene, width, height, report);
+  report_camera(o, scene, width, height, report);
 
   ScratchFolder scratch;
   const PassRunner povray = make_pass_runner(o, setup, frame, scratch);
   KeepFiles keep(scratch, o.keep, report);
   // The data passes libssao reads (depth, normals) see a band around the frame: occluders just
   // outside it darken its edges. The beauty and the ambient pass are the frame.
-  write_wrappers(scratch.path(), setup.scene_name, reading.camera,
+  write_wrappers(scratch.path(), setup.scene_name,
+                 scene_camera_for_frame(o, reading) ? nullptr : &reading.camera,
                  band > 0 ? reading.camera.widened(width, height, band) : reading.camera);
   ImagePasses passes(o, povray, scene, width, height, band, report);
   passes.start();

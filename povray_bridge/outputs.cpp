@@ -67,10 +67,18 @@ void write_depth_only(const Options& o, const AoInputs& in) {
   ssao_tools::write_exr(o.output, in.width, in.height, {"Z", "Radial"}, pixels);
 }
 
-void print_camera(const CameraReading& reading, int width, int height, int band) {
+void print_camera(const CameraReading& reading, bool scene_camera_for_frame, int width, int height,
+                  int band) {
   std::printf("camera: %s\n  read from %s\n", reading.camera.summary().c_str(),
               reading.source.c_str());
-  if (band > 0) {
+  if (scene_camera_for_frame) {
+    std::printf(
+        "the beauty and the ambient pass are rendered with the scene's own camera (its focal "
+        "blur kept)\nthe depth and normal passes, %dx%d%s, without focal blur, with:\n%s",
+        width + 2 * band, height + 2 * band,
+        band > 0 ? (" with a " + std::to_string(band) + "-pixel guard band").c_str() : "",
+        reading.camera.widened(width, height, band).to_sdl().c_str());
+  } else if (band > 0) {
     std::printf("the beauty and the ambient pass are rendered with (after the scene):\n%s",
                 reading.camera.to_sdl().c_str());
     std::printf("the depth and normal passes, %dx%d with a %d-pixel guard band, with:\n%s",

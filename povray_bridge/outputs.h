@@ -19,8 +19,10 @@ void write_outputs(const Options& o, const AoInputs& in, const std::vector<float
 // --depth-only: the frame's Z and Radial channels to -o.
 void write_depth_only(const Options& o, const AoInputs& in);
 
-// --print-camera: the camera read, the camera blocks the passes are rendered with, and libssao's
+// --print-camera: the camera read, the camera blocks the passes are rendered with (the beauty
+// and the ambient pass: the scene's own camera when `scene_camera_for_frame`), and libssao's
 // camera parameters, on stdout.
-void print_camera(const CameraReading& reading, int width, int height, int band);
+void print_camera(const CameraReading& reading, bool scene_camera_for_frame, int width, int height,
+                  int band);
 
 }  // namespace povray_ssao

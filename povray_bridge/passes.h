@@ -35,10 +35,11 @@ constexpr double kAmbientScale = 10000.0;
 
 // The wrapper files, written into `folder`: beauty.pov, depth.pov, ambient.pov and normals.pov.
 // `scene_name` is the scene's file name (POV-Ray runs in the scene's folder). The beauty and
-// the ambient pass (composited per pixel with it) get `camera`; the data passes libssao reads
-// (depth, normals) get `data_camera`, the same camera or one widened for a guard band.
+// the ambient pass (composited per pixel with it) get `frame_camera`, or with nullptr the
+// scene's own camera (its focal blur kept); the data passes libssao reads (depth, normals) get
+// `data_camera`, the frame's camera or one widened for a guard band, never blurred.
 void write_wrappers(const std::string& folder, const std::string& scene_name,
-                    const ResolvedCamera& camera, const ResolvedCamera& data_camera);
+                    const ResolvedCamera* frame_camera, const ResolvedCamera& data_camera);
 
 // The wrappers of the default-camera check (scene_check.h), written into `folder`: the scene's
 // depth as POV-Ray renders it (scene_camera.pov: no camera declared after the scene) and with

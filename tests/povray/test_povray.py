@@ -1317,6 +1317,8 @@ class PostProcessTest(PovTestCase):
         self.assertLess(float(ao[np.isfinite(dist)].mean()), 0.99)
 
 
+# ----------------------------------------------------------------------------------------------
+
 # POV-Ray 3.7's default camera (what it renders a scene without a camera with): perspective at the
 # origin, looking along +z, right 1.33 whatever the image's aspect.
 DEFAULT_CAMERA = ("camera { perspective location <0, 0, 0> direction <0, 0, 1> "
@@ -1374,6 +1376,75 @@ MyCamera(<2, 3, -3>)
         proc = self.run_bridge(scene, "-o", out, "+W32", "+H24", "--camera-location", "2,3,-3",
                                "--camera-look-at", "0,0,5", "--camera-angle", "50")
         self.assert_ok(proc, out)
+
+
+# Focal blur: in focus at the sphere (6.1 from the camera), the floor in front and the box far
+# behind out of focus.
+FOCAL_BLUR_SCENE = """#version 3.7;
+global_settings { assumed_gamma 1.0 }
+camera { location <0, 2, -6> look_at <0, 0.8, 0> angle 50
+         aperture 0.6 focal_point <0, 1, 0> blur_samples 12 }
+light_source { <3, 6, -8> rgb 1 }
+plane { y, 0 pigment { checker rgb 0.8 rgb 0.3 } }
+sphere { <0, 1, 0>, 1 pigment { rgb <0.9, 0.5, 0.3> } }
+box { <-3, 0, 3>, <-1.5, 2, 5> pigment { rgb 0.7 } }
+sphere { <2, 0.5, -2.5>, 0.5 pigment { rgb <0.3, 0.6, 0.9> } }
+"""
+
+
+class FocalBlurTest(PovTestCase):
+    """A camera with focal blur: the beauty (and the ambient pass) as POV-Ray renders them,
+    blurred; AO from sharp depth and normal passes."""
+
+    SIZE = (96, 72)
+
+    def run_scene(self, text, name, *args):
+        scene = self.copy_scene(name + ".pov", text)
+        proc, names, pixels, keep = self.bridge_exr(scene, "--radius", "0.6", *args, name=name,
+                                                    size=self.SIZE)
+        kept = {p: read_image(os.path.join(keep, p + ".exr"))[1]
+                for p in ("beauty", "depth", "ambient")
+                if os.path.isfile(os.path.join(keep, p + ".exr"))}
+        return scene, proc, names, pixels, kept
+
+    def test_beauty_keeps_focal_blur_and_ao_is_sharp(self):
+        scene, proc, names, pixels, kept = self.run_scene(FOCAL_BLUR_SCENE, "blurred")
+        self.assertIn("focal blur: the beauty and the ambient pass keep", proc.stdout,
+                      self.detail(proc))
+        sharp_text = FOCAL_BLUR_SCENE.replace("aperture 0.6", "aperture 0")
+        _, _, sharp_names, sharp_pixels, sharp_kept = self.run_scene(sharp_text, "sharp")
+        # The beauty is POV-Ray's own render of the scene, focal blur included (measured:
+        # identical), and visibly not the sharp one.
+        size = (f"+W{self.SIZE[0]}", f"+H{self.SIZE[1]}")
+        direct = read_image(self.povray(scene, self.path("direct.exr"), "+FE", *size))[1]
+        np.testing.assert_array_equal(kept["beauty"], direct)
+        self.assertGreater(float(np.abs(kept["beauty"] - sharp_kept["beauty"]).max()), 0.1)
+        # So is the ambient pass, which is composited per pixel with it.
+        self.assertGreater(float(np.abs(kept["ambient"] - sharp_kept["ambient"]).max()), 100.0)
+        # The depth pass is the sharp scene's, bit for bit, and so are Z and AO.
+        np.testing.assert_array_equal(kept["depth"], sharp_kept["depth"])
+        for c in ("Z", "AO"):
+            np.testing.assert_array_equal(channel(names, pixels, c),
+                                          channel(sharp_names, sharp_pixels, c), err_msg=c)
+        ao = channel(names, pixels, "AO")
+        self.assertLess(float(ao[np.isfinite(channel(names, pixels, "Z"))].mean()), 0.99)
+
+    def test_multiplied_beauty_and_camera_flags(self):
+        _, proc, names, pixels, kept = self.run_scene(FOCAL_BLUR_SCENE, "beauty", "--apply-to",
+                                                      "beauty")
+        rgb = np.stack([channel(names, pixels, c) for c in "RGB"], -1)
+        ao = channel(names, pixels, "AO")
+        np.testing.assert_allclose(rgb, kept["beauty"][..., :3] * ao[..., None], rtol=1e-5,
+                                   atol=1e-6)
+        # --camera-* flags replace the scene's camera, focal blur included: every pass is sharp.
+        _, proc, _, _, flagged = self.run_scene(FOCAL_BLUR_SCENE, "flags", "--camera-location",
+                                                "0,2,-6")
+        self.assertIn("which the --camera-* flags replace", proc.stderr, self.detail(proc))
+        sharp = self.copy_scene("sharp.pov", FOCAL_BLUR_SCENE.replace("aperture 0.6",
+                                                                      "aperture 0"))
+        size = (f"+W{self.SIZE[0]}", f"+H{self.SIZE[1]}")
+        direct = read_image(self.povray(sharp, self.path("direct.exr"), "+FE", *size))[1]
+        np.testing.assert_allclose(flagged["beauty"], direct, atol=2e-3)
 
 
 # ----------------------------------------------------------------------------------------------
