@@ -46,8 +46,9 @@ std::string upper(std::string text) {
 enum Group { kRender, kCamera, kPost, kOther };
 using FrontOption = ssao_tools::FrontOption<Options, Group>;
 
-const std::vector<FrontOption>& front_options() {
-  static const std::vector<FrontOption> options = {
+// The render mode's options (kRender).
+std::vector<FrontOption> render_options() {
+  return {
       {kRender, "--output", "-o", "OUT.png",
        "output (required): .png, .jpg or .tif: an 8-bit sRGB image of the result; .exr: the "
        "channels of --exr (with --depth-only: Z and Radial)",
@@ -89,7 +90,7 @@ const std::vector<FrontOption>& front_options() {
        "off; default: 10% of the image's larger side",
        [](Options& o, const std::string& f, const std::string& v) {
          const int value = parse_int(f, v);
-         // Bounded again against the image size once that is known (bridge.cpp).
+         // Bounded again against the image size once that is known (scene_setup.cpp).
          if (value < 0 || value > 65536) throw UsageError(f + " must be 0..65536, got " + v);
          o.overscan = value;
        }},
@@ -124,6 +125,12 @@ const std::vector<FrontOption>& front_options() {
        "print the camera read from the scene, the camera block every pass is rendered with and "
        "libssao's camera parameters, then exit (no rendering)",
        [](Options& o, const std::string&, const std::string&) { o.print_camera = true; }},
+  };
+}
+
+// The camera overrides, the post-process mode's options and the others.
+std::vector<FrontOption> camera_post_and_other_options() {
+  return {
       {kCamera, "--camera-location", nullptr, "X,Y,Z", "camera location",
        [](Options& o, const std::string& f, const std::string& v) {
          o.camera.location = parse_vector(f, v);
@@ -188,6 +195,14 @@ const std::vector<FrontOption>& front_options() {
       {kOther, "--version", nullptr, nullptr, "print the library version and exit",
        [](Options& o, const std::string&, const std::string&) { o.version = true; }},
   };
+}
+
+const std::vector<FrontOption>& front_options() {
+  static const std::vector<FrontOption> options = [] {
+    std::vector<FrontOption> all = render_options();
+    for (FrontOption& option : camera_post_and_other_options()) all.push_back(std::move(option));
+    return all;
+  }();
   return options;
 }
 
@@ -394,6 +409,82 @@ Options parse_args(int argc, const char* const* argv, const std::vector<ssao_par
   return out;
 }
 
+// The --help section that explains povray-ssao's choices (size, camera, depth, ...).
+const char* how_values_are_chosen() {
+  return "\n"
+         "How povray-ssao chooses its values:\n"
+         "  Size      --width/--height or +W/+H, else Width/Height of --ini, else of the first\n"
+         "            povray.ini POV-Ray reads ($POVINI, ./povray.ini, ~/.povray/3.7/povray.ini,\n"
+         "            /etc/povray/3.7/povray.ini), else 160x120. Every povray run gets +W +H.\n"
+         "  Camera    POV-Ray's SDL cannot report its camera, so povray-ssao reads the scene's\n"
+         "            last camera { } block: location, look_at, angle, right, up, direction, sky,\n"
+         "            perspective/orthographic, translate/rotate/scale/matrix, with numbers,\n"
+         "            vectors <a,b,c>, + - * / ( ), x y z, image_width, image_height, functions\n"
+         "            (sqrt, sin, vnormalize, ...) and identifiers #declared/#local earlier as\n"
+         "            numbers or vectors. Include files are read where POV-Ray finds them, and\n"
+         "            #if/#switch conditions that can be evaluated (Declare= values included)\n"
+         "            choose their branch. Other camera types (fisheye, panoramic, ...) and\n"
+         "            macro-made cameras are refused; a scene without a camera gets POV-Ray's\n"
+         "            default one (checked with two tiny renders). The resolved camera is\n"
+         "            declared again after the scene in every pass, the beauty included, so all\n"
+         "            passes agree; with focal blur (aperture) the beauty and the ambient pass\n"
+         "            keep the scene's own camera (blurred), the depth and normal passes are\n"
+         "            sharp (with --camera-* flags every pass is sharp).\n"
+         "            libssao: perspective lens = 36 / (2 tan(angle / 2)) mm on a 36 mm sensor\n"
+         "            fitted horizontally; orthographic ortho_scale = |right|; pixel aspect from\n"
+         "            |right| / |up| against W / H.\n"
+         "  Depth     d = -D log1p(-R / 60000) from the fog on R, or from the fog on G once\n"
+         "            d >= 0.7 D1 (then B once d >= 2 D2); rays that hit nothing are background\n"
+         "            (AO 1, Z = inf). EXR output is half-float, so the error depends on\n"
+         "            x = d / D: about 4e-4 of d for x up to 0.7. A camera with look_at at\n"
+         "            distance L gets D1 = 1.5 L, D2 = 10 D1, D3 = 100 D1 (0.02 L .. 300 L within\n"
+         "            2e-3; rendered again with fogs from the measured depths when they fall\n"
+         "            outside). Without look_at, a pre-pass (1/8 of the size, at most 80 pixels\n"
+         "            wide, fogs 1, 100 and 10000) measures the depths; then D1 = 1.5 x the\n"
+         "            median depth and D2 = the 99th percentile / 2, kept within 10..40 x D1; if\n"
+         "            the farthest depth exceeds 2 x D2, a third fog on B with D3 = the farthest\n"
+         "            depth (at least 10 x D2). Depths beyond about 8 x the last fog's distance\n"
+         "            read as background.\n"
+         "            The estimated error of the depth is printed. Glass and mirrors give the\n"
+         "            depth of their own surface; no_image objects are not seen.\n"
+         "  Band      --overscan G, default 10% of the image's larger side (rounded up; less\n"
+         "            if the padded passes would exceed the size limit): the depth and normal\n"
+         "            passes are rendered (W + 2G) x (H + 2G) with the camera's right x (W + 2G)\n"
+         "            / W and up x (H + 2G) / H, so that their inner W x H pixels trace the\n"
+         "            frame's rays; libssao reads the band as context for the frame's edges\n"
+         "            (ssao_job_set_output_window). The beauty and the ambient pass stay W x H.\n"
+         "  Radius    without --radius: 10% of the view's width at the median depth\n"
+         "            (orthographic: of the view's width |right|), in scene units; printed.\n"
+         "  Ambient   the ambient pass sets ambient_light rgb 10000 after the scene; divided by\n"
+         "            10000 and multiplied by the scene's ambient_light (read from its\n"
+         "            global_settings, default rgb 1) it is the ambient term of the beauty. Not\n"
+         "            rendered for scenes with radiosity (POV-Ray 3.7 then ignores ambient) or an\n"
+         "            ambient_light povray-ssao cannot read; --apply-to auto multiplies when the\n"
+         "            ambient light is under 1% of the image's light.\n"
+         "  Animation +KFI/+KFF (Initial_Frame/Final_Frame, with +KI +KF +KC +SF +EF, in an INI\n"
+         "            file too): every frame is rendered on its own, each pass at that frame's\n"
+         "            clock (POV-Ray's own: frame_number, clock, clock_delta as POV-Ray sets\n"
+         "            them), with the camera and fogs read again for it. Outputs are numbered as\n"
+         "            POV-Ray numbers its frames (-o out.png -> out01.png .. out24.png for "
+         "+KFF24),\n"
+         "            or fill a placeholder in the name (-o 'out.####.png'). --radius is\n"
+         "            required (one radius for every frame). A frame that fails is reported, the\n"
+         "            others are written, and the exit status is 1; --keep DIR keeps each frame's\n"
+         "            files in DIR/frameNN.\n"
+         "  Normals   reconstructed from the depth by libssao, except for scenes that include\n"
+         "            \"ssao_passes.inc\": their exact normal pass (Declare=SSAOPass=1 +Q6, the\n"
+         "            rendered camera's basis given as Declare=SSAOBasis...).\n"
+         "  Includes  +L<the scene's folder> and +L<povray-ssao's includes: ssao_depth_pre.inc,\n"
+         "            ssao_depth_post.inc, ssao_ambient_post.inc, ssao_passes.inc>\n"
+         "            (<bin>/../share/povray-ssao, else the\n"
+         "            source tree's povray_bridge/pov) on every povray run.\n"
+         "\n"
+         "Progress and timings go to stdout; warnings, errors and POV-Ray's error lines to "
+         "stderr.\n"
+         "Outputs are written to a temporary name and renamed when complete.\n"
+         "Exit status: 0 success, 1 failure (nothing written), 2 command-line error.\n";
+}
+
 std::string usage_text(const std::vector<ssao_param_desc>& table) {
   std::string text =
       "Usage: povray-ssao SCENE.pov -o OUT.png [+W640 +H480] [--ini FILE.ini] [--exr OUT.exr]\n"
@@ -450,77 +541,7 @@ std::string usage_text(const std::vector<ssao_param_desc>& table) {
       "dashes; the camera parameters, depth_kind and normal_space are set by povray-ssao):\n";
   text += ssao_tools::param_help(
       table, [](const ssao_param_desc& desc) { return !set_by_bridge(desc.name, false); });
-  text +=
-      "\n"
-      "How povray-ssao chooses its values:\n"
-      "  Size      --width/--height or +W/+H, else Width/Height of --ini, else of the first\n"
-      "            povray.ini POV-Ray reads ($POVINI, ./povray.ini, ~/.povray/3.7/povray.ini,\n"
-      "            /etc/povray/3.7/povray.ini), else 160x120. Every povray run gets +W +H.\n"
-      "  Camera    POV-Ray's SDL cannot report its camera, so povray-ssao reads the scene's\n"
-      "            last camera { } block: location, look_at, angle, right, up, direction, sky,\n"
-      "            perspective/orthographic, translate/rotate/scale/matrix, with numbers,\n"
-      "            vectors <a,b,c>, + - * / ( ), x y z, image_width, image_height, functions\n"
-      "            (sqrt, sin, vnormalize, ...) and identifiers #declared/#local earlier as\n"
-      "            numbers or vectors. Include files are read where POV-Ray finds them, and\n"
-      "            #if/#switch conditions that can be evaluated (Declare= values included)\n"
-      "            choose their branch. Other camera types (fisheye, panoramic, ...) and\n"
-      "            macro-made cameras are refused; a scene without a camera gets POV-Ray's\n"
-      "            default one (checked with two tiny renders). The resolved camera is\n"
-      "            declared again after the scene in every pass, the beauty included, so all\n"
-      "            passes agree; with focal blur (aperture) the beauty and the ambient pass\n"
-      "            keep the scene's own camera (blurred), the depth and normal passes are\n"
-      "            sharp (with --camera-* flags every pass is sharp).\n"
-      "            libssao: perspective lens = 36 / (2 tan(angle / 2)) mm on a 36 mm sensor\n"
-      "            fitted horizontally; orthographic ortho_scale = |right|; pixel aspect from\n"
-      "            |right| / |up| against W / H.\n"
-      "  Depth     d = -D log1p(-R / 60000) from the fog on R, or from the fog on G once\n"
-      "            d >= 0.7 D1 (then B once d >= 2 D2); rays that hit nothing are background\n"
-      "            (AO 1, Z = inf). EXR output is half-float, so the error depends on\n"
-      "            x = d / D: about 4e-4 of d for x up to 0.7. A camera with look_at at\n"
-      "            distance L gets D1 = 1.5 L, D2 = 10 D1, D3 = 100 D1 (0.02 L .. 300 L within\n"
-      "            2e-3; rendered again with fogs from the measured depths when they fall\n"
-      "            outside). Without look_at, a pre-pass (1/8 of the size, at most 80 pixels\n"
-      "            wide, fogs 1, 100 and 10000) measures the depths; then D1 = 1.5 x the\n"
-      "            median depth and D2 = the 99th percentile / 2, kept within 10..40 x D1; if\n"
-      "            the farthest depth exceeds 2 x D2, a third fog on B with D3 = the farthest\n"
-      "            depth (at least 10 x D2). Depths beyond about 8 x the last fog's distance\n"
-      "            read as background.\n"
-      "            The estimated error of the depth is printed. Glass and mirrors give the\n"
-      "            depth of their own surface; no_image objects are not seen.\n"
-      "  Band      --overscan G, default 10% of the image's larger side (rounded up; less\n"
-      "            if the padded passes would exceed the size limit): the depth and normal\n"
-      "            passes are rendered (W + 2G) x (H + 2G) with the camera's right x (W + 2G)\n"
-      "            / W and up x (H + 2G) / H, so that their inner W x H pixels trace the\n"
-      "            frame's rays; libssao reads the band as context for the frame's edges\n"
-      "            (ssao_job_set_output_window). The beauty and the ambient pass stay W x H.\n"
-      "  Radius    without --radius: 10% of the view's width at the median depth\n"
-      "            (orthographic: of the view's width |right|), in scene units; printed.\n"
-      "  Ambient   the ambient pass sets ambient_light rgb 10000 after the scene; divided by\n"
-      "            10000 and multiplied by the scene's ambient_light (read from its\n"
-      "            global_settings, default rgb 1) it is the ambient term of the beauty. Not\n"
-      "            rendered for scenes with radiosity (POV-Ray 3.7 then ignores ambient) or an\n"
-      "            ambient_light povray-ssao cannot read; --apply-to auto multiplies when the\n"
-      "            ambient light is under 1% of the image's light.\n"
-      "  Animation +KFI/+KFF (Initial_Frame/Final_Frame, with +KI +KF +KC +SF +EF, in an INI\n"
-      "            file too): every frame is rendered on its own, each pass at that frame's\n"
-      "            clock (POV-Ray's own: frame_number, clock, clock_delta as POV-Ray sets\n"
-      "            them), with the camera and fogs read again for it. Outputs are numbered as\n"
-      "            POV-Ray numbers its frames (-o out.png -> out01.png .. out24.png for +KFF24),\n"
-      "            or fill a placeholder in the name (-o 'out.####.png'). --radius is\n"
-      "            required (one radius for every frame). A frame that fails is reported, the\n"
-      "            others are written, and the exit status is 1; --keep DIR keeps each frame's\n"
-      "            files in DIR/frameNN.\n"
-      "  Normals   reconstructed from the depth by libssao, except for scenes that include\n"
-      "            \"ssao_passes.inc\": their exact normal pass (Declare=SSAOPass=1 +Q6, the\n"
-      "            rendered camera's basis given as Declare=SSAOBasis...).\n"
-      "  Includes  +L<the scene's folder> and +L<povray-ssao's includes: ssao_depth_pre.inc,\n"
-      "            ssao_depth_post.inc, ssao_ambient_post.inc, ssao_passes.inc>\n"
-      "            (<bin>/../share/povray-ssao, else the\n"
-      "            source tree's povray_bridge/pov) on every povray run.\n"
-      "\n"
-      "Progress and timings go to stdout; warnings, errors and POV-Ray's error lines to stderr.\n"
-      "Outputs are written to a temporary name and renamed when complete.\n"
-      "Exit status: 0 success, 1 failure (nothing written), 2 command-line error.\n";
+  text += how_values_are_chosen();
   return text;
 }
 

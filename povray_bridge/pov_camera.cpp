@@ -437,6 +437,77 @@ class BlockParser {
   int conditional() const { return conditionals_.unknown_depth(); }
 };
 
+// Camera types povray-ssao cannot model, types chosen under #if, and items that could not be
+// read: EvalError. An orthographic override makes any type orthographic.
+void check_type_and_errors(const Spec& spec, const CameraOverrides& overrides) {
+  if (!overrides.orthographic) {
+    if (unsupported_types().count(spec.type)) {
+      throw EvalError(spec.type_location + ": the camera is of type '" + spec.type +
+                      "'; povray-ssao supports only perspective and orthographic cameras");
+    }
+    if (spec.type_conditional) {
+      throw EvalError(spec.type_location +
+                      ": the camera's type is chosen inside a conditional "
+                      "directive, which povray-ssao does not evaluate");
+    }
+  }
+  if (!spec.errors.empty()) throw EvalError(spec.errors.front());
+}
+
+// look_at as POV-Ray applies it: direction towards the point, right = sky x direction, up =
+// direction x right, each keeping its length (right its handedness too).
+void point_at(V3 look_at, V3 location, V3 sky, V3& direction, V3& right, V3& up,
+              std::vector<std::string>& warnings) {
+  const double direction_length = length(direction);
+  const double up_length = length(up);
+  const double right_length = length(right);
+  const double handedness = dot(cross(up, direction), right);
+  direction = look_at - location;
+  if (dot(direction, direction) < kEpsilon) {
+    throw EvalError("the camera's location and look_at coincide");
+  }
+  direction = normalized(direction);
+  const V3 saved_right = right;
+  right = cross(sky, direction);
+  if (std::fabs(right.x) < kEpsilon && std::fabs(right.y) < kEpsilon &&
+      std::fabs(right.z) < kEpsilon) {
+    warnings.push_back(
+        "the camera looks along its sky vector; POV-Ray then keeps the "
+        "given right vector");
+    right = saved_right;
+  }
+  right = normalized(right);
+  up = cross(direction, right);
+  direction = direction * direction_length;
+  right = right * (handedness > 0.0 ? right_length : -right_length);
+  up = up * up_length;
+}
+
+// povray-ssao writes the vectors into every pass's scene and libssao's camera: a value that
+// overflowed (e.g. location <1e308 * 10, 0, 0>) would reach them as inf or nan (found by
+// tests/fuzz/fuzz_pov_scene). Vectors that are not perpendicular only get a warning.
+void check_resolved(const ResolvedCamera& camera, std::vector<std::string>& warnings) {
+  auto finite = [](V3 v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); };
+  if (!finite(camera.location) || !finite(camera.direction) || !finite(camera.right) ||
+      !finite(camera.up) || !std::isfinite(camera.look_at_distance)) {
+    throw EvalError(
+        "the camera's location, direction, right or up vector is not finite (a value "
+        "overflows)");
+  }
+  if (!(length(camera.direction) > 0.0) || !(length(camera.right) > 0.0) ||
+      !(length(camera.up) > 0.0)) {
+    throw EvalError("the camera's direction, right or up vector has zero length");
+  }
+  const double k1 = dot(normalized(camera.right), normalized(camera.up));
+  const double k2 = dot(normalized(camera.right), normalized(camera.direction));
+  const double k3 = dot(normalized(camera.up), normalized(camera.direction));
+  if (std::fabs(k1) > 1e-6 || std::fabs(k2) > 1e-6 || std::fabs(k3) > 1e-6) {
+    warnings.push_back(
+        "the camera's right, up and direction vectors are not perpendicular; "
+        "libssao assumes they are, so AO is approximate");
+  }
+}
+
 // Resolves a spec with POV-Ray 3.5+'s rules (Parse_Camera): right, direction, angle (sets
 // |direction| from |right|), up, sky, location, look_at (re-orients right, up, direction keeping
 // their lengths), the orthographic resize, then the transformations in order. Overrides replace
@@ -459,20 +530,8 @@ ResolvedCamera resolve(const Spec& spec, const CameraOverrides& overrides,
   };
 
   ResolvedCamera camera;
-  std::string type = overrides.orthographic ? "orthographic" : spec.type;
-  if (!overrides.orthographic) {
-    if (unsupported_types().count(type)) {
-      throw EvalError(spec.type_location + ": the camera is of type '" + type +
-                      "'; povray-ssao supports only perspective and orthographic cameras");
-    }
-    if (spec.type_conditional) {
-      throw EvalError(spec.type_location +
-                      ": the camera's type is chosen inside a conditional "
-                      "directive, which povray-ssao does not evaluate");
-    }
-  }
-  if (!spec.errors.empty()) throw EvalError(spec.errors.front());
-  camera.orthographic = type == "orthographic";
+  check_type_and_errors(spec, overrides);
+  camera.orthographic = overrides.orthographic || spec.type == "orthographic";
 
   V3 location{0, 0, 0}, direction{0, 0, 1}, up{0, 1, 0}, right{1.33, 0, 0}, sky{0, 1, 0};
   V3 look_at{0, 0, 1};
@@ -530,29 +589,7 @@ ResolvedCamera resolve(const Spec& spec, const CameraOverrides& overrides,
     if (given_look_at) {
       has_look_at = true;
       look_at = *given_look_at;
-      const double direction_length = length(direction);
-      const double up_length = length(up);
-      const double right_length = length(right);
-      const double handedness = dot(cross(up, direction), right);
-      direction = look_at - location;
-      if (dot(direction, direction) < kEpsilon) {
-        throw EvalError("the camera's location and look_at coincide");
-      }
-      direction = normalized(direction);
-      const V3 saved_right = right;
-      right = cross(sky, direction);
-      if (std::fabs(right.x) < kEpsilon && std::fabs(right.y) < kEpsilon &&
-          std::fabs(right.z) < kEpsilon) {
-        warnings.push_back(
-            "the camera looks along its sky vector; POV-Ray then keeps the "
-            "given right vector");
-        right = saved_right;
-      }
-      right = normalized(right);
-      up = cross(direction, right);
-      direction = direction * direction_length;
-      right = right * (handedness > 0.0 ? right_length : -right_length);
-      up = up * up_length;
+      point_at(look_at, location, sky, direction, right, up, warnings);
     }
     if (camera.orthographic && ((!given_up && !given_right) || given_angle)) {
       // POV-Ray sizes an orthographic view like the perspective one at the look_at distance.
@@ -572,28 +609,7 @@ ResolvedCamera resolve(const Spec& spec, const CameraOverrides& overrides,
   camera.right = all.direction(right);
   camera.up = all.direction(up);
 
-  // povray-ssao writes these vectors into every pass's scene and libssao's camera: a value
-  // that overflowed (e.g. location <1e308 * 10, 0, 0>) would reach them as inf or nan (found by
-  // tests/fuzz/fuzz_pov_scene).
-  auto finite = [](V3 v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); };
-  if (!finite(camera.location) || !finite(camera.direction) || !finite(camera.right) ||
-      !finite(camera.up) || !std::isfinite(camera.look_at_distance)) {
-    throw EvalError(
-        "the camera's location, direction, right or up vector is not finite (a value "
-        "overflows)");
-  }
-  if (!(length(camera.direction) > 0.0) || !(length(camera.right) > 0.0) ||
-      !(length(camera.up) > 0.0)) {
-    throw EvalError("the camera's direction, right or up vector has zero length");
-  }
-  const double k1 = dot(normalized(camera.right), normalized(camera.up));
-  const double k2 = dot(normalized(camera.right), normalized(camera.direction));
-  const double k3 = dot(normalized(camera.up), normalized(camera.direction));
-  if (std::fabs(k1) > 1e-6 || std::fabs(k2) > 1e-6 || std::fabs(k3) > 1e-6) {
-    warnings.push_back(
-        "the camera's right, up and direction vectors are not perpendicular; "
-        "libssao assumes they are, so AO is approximate");
-  }
+  check_resolved(camera, warnings);
   return camera;
 }
 

@@ -52,6 +52,55 @@ std::string where(const Token& token) { return token.file + ":" + std::to_string
 // ------------------------------------------------------------------------------------------
 // Tokenizer
 
+namespace {
+
+// The index after the block comment starting at text[i] ("/*"); POV-Ray's block comments nest.
+// Counts the lines it spans into `line`. Throws for a comment left open.
+size_t skip_block_comment(const std::string& text, size_t i, int& line, const std::string& file) {
+  const size_t n = text.size();
+  const int start_line = line;
+  int depth = 0;
+  while (i < n) {
+    if (text[i] == '/' && i + 1 < n && text[i + 1] == '*') {
+      ++depth;
+      i += 2;
+    } else if (text[i] == '*' && i + 1 < n && text[i + 1] == '/') {
+      --depth;
+      i += 2;
+      if (depth == 0) break;
+    } else {
+      if (text[i] == '\n') ++line;
+      ++i;
+    }
+  }
+  if (depth != 0) {
+    throw ssao_tools::Error(file + ":" + std::to_string(start_line) + ": unterminated /* comment");
+  }
+  return i;
+}
+
+// The index after the number starting at text[i]: digits, a fraction, an exponent.
+size_t number_end(const std::string& text, size_t i) {
+  const size_t n = text.size();
+  size_t j = i;
+  while (j < n && std::isdigit(static_cast<unsigned char>(text[j]))) ++j;
+  if (j < n && text[j] == '.') {
+    ++j;
+    while (j < n && std::isdigit(static_cast<unsigned char>(text[j]))) ++j;
+  }
+  if (j < n && (text[j] == 'e' || text[j] == 'E')) {
+    size_t k = j + 1;
+    if (k < n && (text[k] == '+' || text[k] == '-')) ++k;
+    if (k < n && std::isdigit(static_cast<unsigned char>(text[k]))) {
+      while (k < n && std::isdigit(static_cast<unsigned char>(text[k]))) ++k;
+      j = k;
+    }
+  }
+  return j;
+}
+
+}  // namespace
+
 std::vector<Token> tokenize(const std::string& text, const std::string& file) {
   std::vector<Token> tokens;
   int line = 1;
@@ -87,26 +136,7 @@ std::vector<Token> tokenize(const std::string& text, const std::string& file) {
       continue;
     }
     if (c == '/' && i + 1 < n && text[i + 1] == '*') {
-      // POV-Ray's block comments nest.
-      const int start_line = line;
-      int depth = 0;
-      while (i < n) {
-        if (text[i] == '/' && i + 1 < n && text[i + 1] == '*') {
-          ++depth;
-          i += 2;
-        } else if (text[i] == '*' && i + 1 < n && text[i + 1] == '/') {
-          --depth;
-          i += 2;
-          if (depth == 0) break;
-        } else {
-          if (text[i] == '\n') ++line;
-          ++i;
-        }
-      }
-      if (depth != 0) {
-        throw ssao_tools::Error(file + ":" + std::to_string(start_line) +
-                                ": unterminated /* comment");
-      }
+      i = skip_block_comment(text, i, line, file);
       continue;
     }
     if (c == '"') {
@@ -133,20 +163,7 @@ std::vector<Token> tokenize(const std::string& text, const std::string& file) {
     }
     if (std::isdigit(static_cast<unsigned char>(c)) ||
         (c == '.' && i + 1 < n && std::isdigit(static_cast<unsigned char>(text[i + 1])))) {
-      size_t j = i;
-      while (j < n && std::isdigit(static_cast<unsigned char>(text[j]))) ++j;
-      if (j < n && text[j] == '.') {
-        ++j;
-        while (j < n && std::isdigit(static_cast<unsigned char>(text[j]))) ++j;
-      }
-      if (j < n && (text[j] == 'e' || text[j] == 'E')) {
-        size_t k = j + 1;
-        if (k < n && (text[k] == '+' || text[k] == '-')) ++k;
-        if (k < n && std::isdigit(static_cast<unsigned char>(text[k]))) {
-          while (k < n && std::isdigit(static_cast<unsigned char>(text[k]))) ++k;
-          j = k;
-        }
-      }
+      const size_t j = number_end(text, i);
       Token token = make(Token::kNumber, text.substr(i, j - i));
       token.number = std::strtod(token.text.c_str(), nullptr);
       tokens.push_back(token);

@@ -1,12 +1,13 @@
 // SPDX-License-Identifier: MIT
 // libFuzzer target: povray-ssao's scene reader (povray_bridge/sdl.cpp, pov_camera.cpp) on random
-// scene text, the way render_image() in bridge.cpp uses it: scan_scene on a scene file (written
-// to a scratch folder; its #include files resolve there and in povray_bridge/pov), read_camera
-// on the scan, then the camera's SDL, summary, pixel mapping and the library's camera
-// parameters. Also tokenize + evaluate_full from every token of the text (the evaluator behind
-// #declare, #if and the camera's values). Everything must work or throw ssao_tools::Error (the
-// evaluator's EvalError is one); a camera that reads must have finite vectors, since povray-ssao
-// writes them into every pass's scene.
+// scene text, the way read_image_scene() in scene_setup.cpp uses it: scan_scene on a scene file
+// (written to a scratch folder; its #include files resolve there and in povray_bridge/pov),
+// read_camera on the scan (a scan without a camera gives POV-Ray's default one), then the
+// camera's SDL, summary, pixel mapping and the library's camera parameters. Also tokenize +
+// evaluate_full from every token of the text (the evaluator behind #declare, #if and the
+// camera's values). Everything must work or throw ssao_tools::Error (the evaluator's EvalError
+// is one); a camera that reads must have finite vectors, since povray-ssao writes them into
+// every pass's scene.
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
