@@ -66,18 +66,6 @@ void choose_default_radius(ssao::api::Job& job, const Options& o, const AoInputs
                   radius, in.camera.orthographic ? "" : " at the median depth");
 }
 
-// Mean AO over the frame's geometry pixels, for the progress line.
-double mean_geometry_ao(const AoInputs& in, const std::vector<float>& ao, size_t& geometry) {
-  double sum = 0.0;
-  geometry = 0;
-  for (size_t p = 0; p < in.frame_pixels(); ++p) {
-    if (!std::isfinite(in.radial[p])) continue;
-    sum += ao[p];
-    ++geometry;
-  }
-  return geometry ? sum / static_cast<double>(geometry) : 1.0;
-}
-
 }  // namespace
 
 double compute_and_write(const Options& o, AoInputs& in, const Reporter& report) {
@@ -101,9 +89,9 @@ double compute_and_write(const Options& o, AoInputs& in, const Reporter& report)
   }
   ssao::api::check_status(status, "SSAO failed");
   if (gamma) raise_rgb(images.composite, in.working_gamma);
-  size_t geometry = 0;
-  const double mean = mean_geometry_ao(in, images.ao, geometry);
-  report.end("%.2f s, mean AO %.3f over %zu geometry pixels", seconds, mean, geometry);
+  const ssao::api::Job::RunStats stats = job.last_run();  // the library's background rule
+  report.end("%.2f s, mean AO %.3f over %zu geometry pixels", seconds, stats.mean_ao,
+             stats.geometry_pixels);
   write_outputs(o, in, images.composite, images.ao);
   return seconds;
 }

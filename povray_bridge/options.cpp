@@ -208,7 +208,7 @@ const std::vector<FrontOption>& front_options() {
 
 // Library parameters povray-ssao sets itself from the POV-Ray camera and the passes.
 bool set_by_bridge(const std::string& name, bool post_process) {
-  if (ssao_tools::is_camera_param(name)) return true;
+  if (ssao_tools::is_camera_param(name)) return true;  // the library's "camera" group
   if (name == "normal_space") return true;
   return name == "depth_kind" && !post_process;
 }

@@ -714,21 +714,15 @@ void ResolvedCamera::apply_to_job(ssao::api::Job& job, int width, int height) co
   }
 }
 
+// POV-Ray's image plane lies at |direction| from the eye and spans |right| across the width and
+// |up| down the height, centred on the view axis: in libssao's pinhole intrinsics, W |direction|
+// / |right| pixels per unit of x at unit depth (orthographic: W / |right| pixels per scene unit).
 void ResolvedCamera::set_job_camera(ssao::api::Job& job, int width, int height) const {
   const double r = length(right), u = length(up), d = length(direction);
+  const double w = width, h = height, distance = orthographic ? 1.0 : d;
+  job.set("projection", "intrinsics");
   job.set("camera_type", orthographic ? "ORTHO" : "PERSP");
-  job.set("sensor_fit", "HORIZONTAL");
-  job.set("sensor_width", 36.0);
-  job.set("shift_x", 0.0);
-  job.set("shift_y", 0.0);
-  if (orthographic) {
-    job.set("ortho_scale", r);
-  } else {
-    job.set("lens", 36.0 * d / r);  // = 36 / (2 tan(angle / 2))
-  }
-  // libssao's view height is H * pixel_aspect_y / W of its width: make it |up| / |right|.
-  job.set("pixel_aspect_x", 1.0);
-  job.set("pixel_aspect_y", static_cast<double>(width) * u / (static_cast<double>(height) * r));
+  job.set("intrinsics", std::vector<double>{w * distance / r, h * distance / u, w / 2.0, h / 2.0});
 }
 
 double ResolvedCamera::radial_factor(int px, int py, int width, int height) const {
