@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "error.h"
+#include "variants/variant.h"
 
 namespace ssao {
 namespace {
@@ -36,6 +37,17 @@ Param matrix_param(const char* group, const char* name, const char* description)
   return {group, {name, SSAO_PARAM_FLOATS, 0.0, 0.0, 0.0, nullptr, nullptr, 16, "", description}};
 }
 
+// The variant parameter's choices: the registry's names, in its order (not written again here).
+const char* variant_choices() {
+  static const std::string choices = [] {
+    std::string out;
+    for (const VariantInfo& v : variant_registry())
+      out += (out.empty() ? "" : "|") + std::string(v.name);
+    return out;
+  }();
+  return choices.c_str();
+}
+
 // Groups, in the order front ends show them.
 constexpr const char* kAo = "ao";            // what the estimate computes
 constexpr const char* kQuality = "quality";  // how much work it does
@@ -49,7 +61,7 @@ constexpr const char* kExecution = "execution";
 const std::vector<Param>& params() {
   static const std::vector<Param> params = {
       // --- algorithm ---
-      string_param(kAo, "variant", "hemisphere", "horizon|hemisphere|sphere|volumetric|unsharp",
+      string_param(kAo, "variant", "hemisphere", variant_choices(),
                    "horizon: horizon-based slices with a visibility bitmask (GTAO), kept for "
                    "comparison: 7-15x the default's time and less accurate on the benchmark "
                    "scenes but the one with thin occluders (docs/variants.md); hemisphere: "
