@@ -167,39 +167,10 @@ void check_exr_header_sizes(const std::string& path) {
   }
 }
 
-// A multi-part EXR (Blender 5.x writes a multilayer file as one part per layer) reads as one
-// image with the channels of every part, in file order. Parts of another size are refused.
-void append_exr_parts(OIIO::ImageInput& input, const std::string& path, Image& image,
-                      const OIIO::ImageSpec& first) {
-  for (int part = 1; input.seek_subimage(part, 0); ++part) {
-    const OIIO::ImageSpec spec = input.spec();
-    if (spec.width != image.width || spec.height != image.height || spec.x != first.x ||
-        spec.y != first.y || spec.deep || spec.depth > 1) {
-      throw Error("cannot read " + quoted(path) + ": its part " + std::to_string(part) + " (" +
-                  std::string(spec.get_string_attribute("name")) +
-                  ") is not the size of the first");
-    }
-    const int old_channels = image.channels();
-    const int channels = old_channels + spec.nchannels;
-    const size_t pixels = image.pixel_count();
-    std::vector<float> part_pixels(
-        checked_float_count(spec.width, spec.height, spec.nchannels, path));
-    if (!input.read_image(part, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, part_pixels.data())) {
-      throw Error("cannot read " + quoted(path) + ": the file is truncated or corrupt (" +
-                  oiio_detail(input.geterror()) + ")");
-    }
-    std::vector<float> merged(checked_float_count(image.width, image.height, channels, path));
-    for (size_t i = 0; i < pixels; ++i) {
-      std::copy_n(&image.pixels[i * old_channels], old_channels, &merged[i * channels]);
-      std::copy_n(&part_pixels[i * spec.nchannels], spec.nchannels,
-                  &merged[i * channels + old_channels]);
-    }
-    image.pixels.swap(merged);
-    for (int c = 0; c < spec.nchannels; ++c) image.channel_names.push_back(spec.channel_name(c));
-  }
-}
-
-Image read(const std::string& path) {
+// Opens `path` and checks its first part: deep and volume images are refused, and so is a data
+// window that leaves part of the display window out. Fills everything of `image` but its pixels
+// from the first part.
+std::unique_ptr<OIIO::ImageInput> open_image(const std::string& path, Image& image) {
   require_readable_file(path);
   check_exr_header_sizes(path);
   auto input = OIIO::ImageInput::open(path);
@@ -207,7 +178,7 @@ Image read(const std::string& path) {
     throw Error("cannot read " + quoted(path) + ": not an image file OpenImageIO can read, or " +
                 "its header is damaged (" + oiio_detail(OIIO::geterror()) + ")");
   }
-  const OIIO::ImageSpec spec = input->spec();
+  const OIIO::ImageSpec& spec = input->spec();
   if (spec.deep) throw Error("cannot read " + quoted(path) + ": deep images are not supported");
   if (spec.depth > 1)
     throw Error("cannot read " + quoted(path) + ": volume images are not supported");
@@ -223,8 +194,6 @@ Image read(const std::string& path) {
                 " at " + std::to_string(spec.full_x) + ", " + std::to_string(spec.full_y) +
                 "); pad it to the full frame first");
   }
-
-  Image image;
   image.width = spec.width;
   image.height = spec.height;
   image.frame_x = spec.full_x - spec.x;
@@ -232,25 +201,176 @@ Image read(const std::string& path) {
   image.frame_width = spec.full_width;
   image.frame_height = spec.full_height;
   image.color_space = spec.get_string_attribute("oiio:ColorSpace");
-  const size_t count = checked_float_count(spec.width, spec.height, spec.nchannels, path);
+  image.channel_names.clear();
   for (int c = 0; c < spec.nchannels; ++c) image.channel_names.push_back(spec.channel_name(c));
-  try {
-    image.pixels.resize(count);
-  } catch (const std::bad_alloc&) {
-    throw Error("cannot read " + quoted(path) + ": out of memory for " +
-                std::to_string(spec.width) + " x " + std::to_string(spec.height) + " x " +
-                std::to_string(spec.nchannels) + " floats");
+  return input;
+}
+
+bool is_exr(OIIO::ImageInput& input) { return std::string(input.format_name()) == "openexr"; }
+
+// A multi-part EXR (Blender 5.x writes a multilayer file as one part per layer) reads as one
+// image with the channels of every part, in file order. Parts of another size are refused.
+void check_part(const OIIO::ImageSpec& spec, const OIIO::ImageSpec& first, int part,
+                const std::string& path) {
+  if (spec.width != first.width || spec.height != first.height || spec.x != first.x ||
+      spec.y != first.y || spec.deep || spec.depth > 1) {
+    throw Error("cannot read " + quoted(path) + ": its part " + std::to_string(part) + " (" +
+                std::string(spec.get_string_attribute("name")) + ") is not the size of the first");
   }
-  const bool ok =
-      input->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, image.pixels.data());
-  if (!ok) {
-    throw Error("cannot read " + quoted(path) + ": the file is truncated or corrupt (" +
-                oiio_detail(input->geterror()) + ")");
+}
+
+// Channels [begin, end) of a part (OpenImageIO's channel order), consecutive in the caller's
+// memory: channel begin + k of pixel (x, y) at data[y * row_stride + x * pixel_stride + k].
+struct Run {
+  int part;
+  int begin, end;
+  float* data;
+  std::ptrdiff_t pixel_stride, row_stride;  // floats
+};
+
+// Scanlines in one block of an OpenEXR file with this compression.
+int exr_block_rows(const std::string& compression) {
+  if (compression == "none" || compression == "rle" || compression == "zips") return 1;
+  if (compression == "piz" || compression == "b44" || compression == "b44a" ||
+      compression == "dwaa") {
+    return 32;
   }
-  if (std::string(input->format_name()) == "openexr") {
-    append_exr_parts(*input, path, image, spec);
+  if (compression == "dwab") return 256;
+  return 16;  // zip, pxr24
+}
+
+[[noreturn]] void throw_corrupt(OIIO::ImageInput& input, const std::string& path) {
+  throw Error("cannot read " + quoted(path) + ": the file is truncated or corrupt (" +
+              oiio_detail(input.geterror()) + ")");
+}
+
+// Reads the runs of one part. A single run is one read of the part. Several runs of an OpenEXR
+// part in scanlines are read band by band, every run of a band before the next band: OpenEXR
+// keeps the last 2 x its threads (at least 1) blocks of scanlines it decompressed, so a band of
+// as many blocks as it has threads is decompressed once, for its first run, however many follow.
+// Other files (tiled, other formats) with several runs: the channels the runs span are read in
+// one go into a temporary and copied out.
+void read_part_runs(OIIO::ImageInput& input, const OIIO::ImageSpec& spec, int subimage,
+                    const std::vector<Run>& runs, const std::string& path) {
+  const OIIO::TypeDesc f = OIIO::TypeDesc::FLOAT;
+  const auto bytes = [](std::ptrdiff_t floats) {
+    return static_cast<OIIO::stride_t>(floats) * static_cast<OIIO::stride_t>(sizeof(float));
+  };
+  if (runs.size() == 1) {
+    const Run& r = runs.front();
+    if (!input.read_image(subimage, 0, r.begin, r.end, f, r.data, bytes(r.pixel_stride),
+                          bytes(r.row_stride))) {
+      throw_corrupt(input, path);
+    }
+    return;
+  }
+  if (is_exr(input) && spec.tile_width == 0) {
+    int threads = 0;
+    OIIO::getattribute("exr_threads", threads);
+    const int band =
+        exr_block_rows(spec.get_string_attribute("compression")) * std::max(1, threads);
+    for (int y = 0; y < spec.height; y += band) {
+      const int rows = std::min(band, spec.height - y);
+      for (const Run& r : runs) {
+        if (!input.read_scanlines(subimage, 0, spec.y + y, spec.y + y + rows, 0, r.begin, r.end, f,
+                                  r.data + std::ptrdiff_t(y) * r.row_stride, bytes(r.pixel_stride),
+                                  bytes(r.row_stride))) {
+          throw_corrupt(input, path);
+        }
+      }
+    }
+    return;
+  }
+  int begin = runs.front().begin, end = runs.front().end;
+  for (const Run& r : runs) {
+    begin = std::min(begin, r.begin);
+    end = std::max(end, r.end);
+  }
+  const int span = end - begin;
+  std::vector<float> pixels(checked_float_count(spec.width, spec.height, span, path));
+  if (!input.read_image(subimage, 0, begin, end, f, pixels.data())) throw_corrupt(input, path);
+  for (const Run& r : runs) {
+    for (int y = 0; y < spec.height; ++y) {
+      for (int x = 0; x < spec.width; ++x) {
+        const float* in = &pixels[(size_t(y) * size_t(spec.width) + size_t(x)) * size_t(span) +
+                                  size_t(r.begin - begin)];
+        std::copy_n(in, r.end - r.begin,
+                    r.data + std::ptrdiff_t(y) * r.row_stride + std::ptrdiff_t(x) * r.pixel_stride);
+      }
+    }
+  }
+}
+
+Image read_channels(const std::string& path, const ChannelChooser& choose) {
+  Image image;
+  auto input = open_image(path, image);
+  struct Part {
+    int subimage, first;  // first: its first channel's index in image.channel_names
+    OIIO::ImageSpec spec;
+  };
+  std::vector<Part> parts = {{0, 0, input->spec()}};
+  if (is_exr(*input)) {
+    for (int part = 1; input->seek_subimage(part, 0); ++part) {
+      const OIIO::ImageSpec spec = input->spec();
+      check_part(spec, parts.front().spec, part, path);
+      parts.push_back({part, image.channels(), spec});
+      for (int c = 0; c < spec.nchannels; ++c) image.channel_names.push_back(spec.channel_name(c));
+    }
+  }
+
+  // Consecutive targets that continue each other (the next channel of the same part, the next
+  // float of the same pixel) make one run.
+  std::vector<Run> runs;
+  for (const ChannelTarget& t : choose(image)) {
+    if (t.channel < 0 || t.channel >= image.channels() || t.data == nullptr) {
+      throw Error("cannot read " + quoted(path) + ": internal error: no channel " +
+                  std::to_string(t.channel) + " or no memory for it");
+    }
+    size_t p = parts.size() - 1;
+    while (parts[p].first > t.channel) --p;
+    const int local = t.channel - parts[p].first;
+    if (!runs.empty()) {
+      Run& r = runs.back();
+      if (r.part == int(p) && r.end == local && r.data + (r.end - r.begin) == t.data &&
+          r.pixel_stride == t.pixel_stride && r.row_stride == t.row_stride) {
+        ++r.end;
+        continue;
+      }
+    }
+    runs.push_back({int(p), local, local + 1, t.data, t.pixel_stride, t.row_stride});
+  }
+  for (const Part& part : parts) {
+    std::vector<Run> mine;
+    for (const Run& r : runs) {
+      if (r.part == part.subimage) mine.push_back(r);
+    }
+    if (!mine.empty()) read_part_runs(*input, part.spec, part.subimage, mine, path);
   }
   input->close();
+  return image;
+}
+
+// Every channel, interleaved: read_channels with one target per channel (a multi-part file's
+// parts are read straight into their place).
+Image read(const std::string& path) {
+  std::vector<float> pixels;
+  Image image = read_channels(path, [&](const Image& header) {
+    const int channels = header.channels();
+    const size_t count = checked_float_count(header.width, header.height, channels, path);
+    try {
+      pixels.resize(count);
+    } catch (const std::bad_alloc&) {
+      throw Error("cannot read " + quoted(path) + ": out of memory for " +
+                  std::to_string(header.width) + " x " + std::to_string(header.height) + " x " +
+                  std::to_string(channels) + " floats");
+    }
+    std::vector<ChannelTarget> targets;
+    for (int c = 0; c < channels; ++c) {
+      targets.push_back({c, pixels.data() + c, channels, std::ptrdiff_t(channels) * header.width});
+    }
+    return targets;
+  });
+  image.pixels = std::move(pixels);
   return image;
 }
 
@@ -292,10 +412,10 @@ float srgb_encode(float linear) {
 }
 
 void write_exr_file(const std::string& path, int width, int height,
-                    const std::vector<std::string>& channel_names,
-                    const std::vector<float>& pixels) {
+                    const std::vector<std::string>& channel_names, const float* pixels,
+                    size_t count) {
   const int channels = static_cast<int>(channel_names.size());
-  check_image_buffer(path, width, height, channels, pixels.size());
+  check_image_buffer(path, width, height, channels, count);
   OIIO::ImageSpec spec(width, height, channels, OIIO::TypeDesc::FLOAT);
   spec.channelnames = channel_names;
   spec.alpha_channel = -1;
@@ -303,14 +423,14 @@ void write_exr_file(const std::string& path, int width, int height,
     if (channel_names[static_cast<size_t>(c)] == "A") spec.alpha_channel = c;
   }
   spec.attribute("compression", "zip");
-  write_atomically(path, "openexr", spec, OIIO::TypeDesc::FLOAT, pixels.data());
+  write_atomically(path, "openexr", spec, OIIO::TypeDesc::FLOAT, pixels);
 }
 
 void write_preview_file(const std::string& path, int width, int height,
-                        const std::vector<std::string>& channel_names,
-                        const std::vector<float>& pixels) {
+                        const std::vector<std::string>& channel_names, const float* pixels,
+                        size_t float_count) {
   const int channels = static_cast<int>(channel_names.size());
-  check_image_buffer(path, width, height, channels, pixels.size());
+  check_image_buffer(path, width, height, channels, float_count);
   auto index_of = [&](const char* name) {
     const auto it = std::find(channel_names.begin(), channel_names.end(), name);
     return it == channel_names.end() ? -1 : static_cast<int>(it - channel_names.begin());
@@ -334,7 +454,7 @@ void write_preview_file(const std::string& path, int width, int height,
   const size_t count = static_cast<size_t>(width) * static_cast<size_t>(height);
   std::vector<unsigned char> bytes(count * static_cast<size_t>(out_channels));
   for (size_t p = 0; p < count; ++p) {
-    const float* in = pixels.data() + p * static_cast<size_t>(channels);
+    const float* in = pixels + p * static_cast<size_t>(channels);
     unsigned char* out = bytes.data() + p * static_cast<size_t>(out_channels);
     for (size_t k = 0; k < picked.size(); ++k) {
       out[k] = static_cast<unsigned char>(std::lround(255.0f * srgb_encode(in[picked[k]])));
@@ -368,13 +488,16 @@ const ImageCodec kCodec = {
     [](const std::string& path, Image& image, std::string& error) {
       return guarded(error, [&] { image = read(path); });
     },
-    [](const std::string& path, int width, int height, const std::vector<std::string>& names,
-       const std::vector<float>& pixels, std::string& error) {
-      return guarded(error, [&] { write_exr_file(path, width, height, names, pixels); });
+    [](const std::string& path, Image& header, const ChannelChooser& choose, std::string& error) {
+      return guarded(error, [&] { header = read_channels(path, choose); });
     },
     [](const std::string& path, int width, int height, const std::vector<std::string>& names,
-       const std::vector<float>& pixels, std::string& error) {
-      return guarded(error, [&] { write_preview_file(path, width, height, names, pixels); });
+       const float* pixels, size_t count, std::string& error) {
+      return guarded(error, [&] { write_exr_file(path, width, height, names, pixels, count); });
+    },
+    [](const std::string& path, int width, int height, const std::vector<std::string>& names,
+       const float* pixels, size_t count, std::string& error) {
+      return guarded(error, [&] { write_preview_file(path, width, height, names, pixels, count); });
     },
 };
 

@@ -7,8 +7,11 @@
 #include <cctype>
 #include <cmath>
 #include <cstdlib>
+#include <exception>
 #include <filesystem>
+#include <limits>
 #include <mutex>
+#include <stdexcept>
 
 #include "tools/image_codec.h"
 
@@ -76,10 +79,9 @@ std::string join_names(const std::vector<std::string>& names, const char* separa
   return out;
 }
 
-Image read_image(const std::string& path, Overscan overscan) {
-  Image image;
-  std::string error;
-  if (!codec().read(path, image, error)) throw Error(error);
+namespace {
+
+void check_overscan(const Image& image, Overscan overscan, const std::string& path) {
   if (image.has_overscan() && overscan == Overscan::refuse) {
     throw Error("cannot read " + quoted(path) + ": its data window (" +
                 std::to_string(image.width) + " x " + std::to_string(image.height) +
@@ -87,7 +89,60 @@ Image read_image(const std::string& path, Overscan overscan) {
                 " x " + std::to_string(image.frame_height) +
                 "); crop it to the display window first");
   }
+}
+
+}  // namespace
+
+Image read_image(const std::string& path, Overscan overscan) {
+  Image image;
+  std::string error;
+  if (!codec().read(path, image, error)) throw Error(error);
+  check_overscan(image, overscan, path);
   return image;
+}
+
+Image read_channels(const std::string& path, Overscan overscan, const ChannelChooser& choose) {
+  // What `choose` throws crosses the module as a message; it is thrown again here as it was.
+  std::exception_ptr failure;
+  const ChannelChooser checked = [&](const Image& header) {
+    try {
+      check_overscan(header, overscan, path);
+      return choose(header);
+    } catch (...) {
+      failure = std::current_exception();
+      throw;
+    }
+  };
+  Image header;
+  std::string error;
+  if (!codec().read_channels(path, header, checked, error)) {
+    if (failure) std::rethrow_exception(failure);
+    throw Error(error);
+  }
+  return header;
+}
+
+void resize_pass_buffer(FloatBuffer& buffer, const Image& image, int channels,
+                        const std::string& path) {
+  const size_t pixels = image.pixel_count();
+  const size_t per_pixel = static_cast<size_t>(channels > 0 ? channels : 0);
+  const auto too_large = [&](const char* what) {
+    return Error("cannot read " + quoted(path) + ": " + what + " for " +
+                 std::to_string(image.width) + " x " + std::to_string(image.height) + " x " +
+                 std::to_string(channels) + " floats");
+  };
+  if (per_pixel != 0 && pixels > std::numeric_limits<size_t>::max() / sizeof(float) / per_pixel) {
+    throw too_large("image too large");
+  }
+  const size_t count = pixels * per_pixel;
+  try {
+    if (count > buffer.capacity()) buffer = FloatBuffer();  // no copy of the old values
+    buffer.resize(count);
+  } catch (const std::bad_alloc&) {
+    throw too_large("out of memory");
+  } catch (const std::length_error&) {
+    throw too_large("image too large");
+  }
 }
 
 bool linearize(Image& image) {
@@ -150,25 +205,58 @@ std::vector<float> extract_channels(const Image& image, const std::vector<int>& 
   return out;
 }
 
-FrameView frame_view(const Image& image, std::vector<float>& pass, int channels) {
+FrameView frame_view(const Image& image, float* pass, int channels) {
   const size_t first = static_cast<size_t>(image.frame_y) * static_cast<size_t>(image.width) +
                        static_cast<size_t>(image.frame_x);
   const std::ptrdiff_t pixel_bytes = std::ptrdiff_t(channels) * std::ptrdiff_t(sizeof(float));
-  return {pass.data() + first * static_cast<size_t>(channels), pixel_bytes,
-          pixel_bytes * image.width};
+  return {pass + first * static_cast<size_t>(channels), pixel_bytes, pixel_bytes * image.width};
 }
+
+FrameView frame_view(const Image& image, std::vector<float>& pass, int channels) {
+  return frame_view(image, pass.data(), channels);
+}
+
+namespace {
+
+size_t float_count(int width, int height, const std::vector<std::string>& channel_names) {
+  if (width <= 0 || height <= 0) return 0;  // refused by the codec, which says why
+  return static_cast<size_t>(width) * static_cast<size_t>(height) * channel_names.size();
+}
+
+}  // namespace
 
 void write_exr(const std::string& path, int width, int height,
                const std::vector<std::string>& channel_names, const std::vector<float>& pixels) {
   std::string error;
-  if (!codec().write_exr(path, width, height, channel_names, pixels, error)) throw Error(error);
+  if (!codec().write_exr(path, width, height, channel_names, pixels.data(), pixels.size(), error)) {
+    throw Error(error);
+  }
+}
+
+void write_exr_pixels(const std::string& path, int width, int height,
+                      const std::vector<std::string>& channel_names, const float* pixels) {
+  std::string error;
+  if (!codec().write_exr(path, width, height, channel_names, pixels,
+                         float_count(width, height, channel_names), error)) {
+    throw Error(error);
+  }
 }
 
 void write_preview(const std::string& path, int width, int height,
                    const std::vector<std::string>& channel_names,
                    const std::vector<float>& pixels) {
   std::string error;
-  if (!codec().write_preview(path, width, height, channel_names, pixels, error)) {
+  if (!codec().write_preview(path, width, height, channel_names, pixels.data(), pixels.size(),
+                             error)) {
+    throw Error(error);
+  }
+}
+
+void write_preview_pixels(const std::string& path, int width, int height,
+                          const std::vector<std::string>& channel_names, const float* pixels) {
+  std::string error;
+  if (!codec().write_preview(path, width, height, channel_names, pixels,
+                             float_count(width, height, channel_names), error)) {
     throw Error(error);
   }
 }

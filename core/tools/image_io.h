@@ -6,7 +6,11 @@
 #pragma once
 
 #include <cstddef>
+#include <functional>
+#include <memory>
+#include <new>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "tools/error.h"
@@ -42,12 +46,63 @@ struct Image {
 
 enum class Overscan { refuse, read };
 
+// std::allocator, except that a vector's resize() leaves new elements uninitialised: for buffers
+// that read_channels or the library fill whole, which need not be zeroed first.
+template <typename T>
+struct UninitializedAllocator : std::allocator<T> {
+  template <typename U>
+  struct rebind {
+    using other = UninitializedAllocator<U>;
+  };
+  UninitializedAllocator() = default;
+  template <typename U>
+  UninitializedAllocator(const UninitializedAllocator<U>&) noexcept {}
+  template <typename U>
+  void construct(U* p) noexcept {
+    ::new (static_cast<void*>(p)) U;
+  }
+  template <typename U, typename... Args>
+  void construct(U* p, Args&&... args) {
+    ::new (static_cast<void*>(p)) U(std::forward<Args>(args)...);
+  }
+};
+using FloatBuffer = std::vector<float, UninitializedAllocator<float>>;
+
+// Where read_channels puts one channel of the file: the value of pixel (x, y) of the data window
+// (x, y from 0, y = 0 the top row) goes to data[y * row_stride + x * pixel_stride], strides in
+// floats. The memory belongs to the caller.
+struct ChannelTarget {
+  int channel;  // index in Image::channel_names
+  float* data;
+  std::ptrdiff_t pixel_stride, row_stride;
+};
+// Given the file's header (an Image without pixels), the channels to read and where; may throw
+// (the exception reaches read_channels' caller as it was thrown).
+using ChannelChooser = std::function<std::vector<ChannelTarget>(const Image& header)>;
+
 // Reads the first subimage of `path` as 32-bit float. Throws Error for a missing file, a file
 // that is not an image OIIO can read, a truncated or corrupt file (OIIO's message included), a
 // deep image, a data window that does not cover the display window, or, unless `overscan` is
 // read, a data window larger than the display window (overscan: with Overscan::read the whole
 // data window is read, and frame_* locate the display window in it).
 Image read_image(const std::string& path, Overscan overscan = Overscan::refuse);
+
+// Reads only some channels of `path`, each straight into the caller's memory: the header (with
+// the checks and messages of read_image, for the same `overscan`), then `choose`, then the chosen
+// channels as 32-bit float, bit for bit what read_image gives for them. Nothing else of the file
+// is decoded where the format allows it: of a multi-part EXR only the parts that hold a chosen
+// channel are read; of a part, only the chosen channels are converted and copied (OpenEXR
+// decompresses whole blocks of scanlines: the channels of a part are read block by block, so
+// that each block is decompressed once). Returns the header: channel_names of every part, in
+// file order (as read_image), and no pixels. Throws Error as read_image does.
+Image read_channels(const std::string& path, Overscan overscan, const ChannelChooser& choose);
+
+// Makes `buffer` hold `channels` floats a pixel of the data window of `image` (read from `path`,
+// named in the message), reusing its memory when it is large enough (a sequence's frames reuse
+// the buffers of the frame before: no new pages to fault in); the values are left as they are.
+// Throws Error when that many floats cannot be had.
+void resize_pass_buffer(FloatBuffer& buffer, const Image& image, int channels,
+                        const std::string& path);
 
 // Converts the stored values of an image read from an sRGB- or gamma-encoded file
 // (color_space "sRGB", "GammaCorrected<g>" or "Gamma<g>", e.g. an 8-bit PNG) to linear light,
@@ -73,6 +128,7 @@ struct FrameView {
   std::ptrdiff_t pixel_stride, row_stride;
 };
 FrameView frame_view(const Image& image, std::vector<float>& pass, int channels);
+FrameView frame_view(const Image& image, float* pass, int channels);
 
 // Writes `pixels` (interleaved, top row first, channel_names.size() channels) as a 32-bit float,
 // ZIP-compressed OpenEXR file, whatever the extension of `path`. The data go to a temporary
@@ -80,12 +136,17 @@ FrameView frame_view(const Image& image, std::vector<float>& pass, int channels)
 // never leaves a partial file under the final name. Throws Error on failure.
 void write_exr(const std::string& path, int width, int height,
                const std::vector<std::string>& channel_names, const std::vector<float>& pixels);
+// The same from width * height * channel_names.size() floats at `pixels`.
+void write_exr_pixels(const std::string& path, int width, int height,
+                      const std::vector<std::string>& channel_names, const float* pixels);
 
 // Writes a display-referred 8-bit preview (PNG, JPEG or TIFF by the extension of `path`): R, G,
 // B (and A) if those channels exist, otherwise the AO channel (or the first) as grey; colour
 // and AO values clamped to [0, 1] and sRGB-encoded, alpha kept linear. Atomic like write_exr.
 void write_preview(const std::string& path, int width, int height,
                    const std::vector<std::string>& channel_names, const std::vector<float>& pixels);
+void write_preview_pixels(const std::string& path, int width, int height,
+                          const std::vector<std::string>& channel_names, const float* pixels);
 
 // True for the extensions write_preview handles (.png, .jpg, .jpeg, .tif, .tiff).
 bool is_preview_path(const std::string& path);

@@ -1,10 +1,12 @@
 // SPDX-License-Identifier: MIT
 // libFuzzer target: the command-line tool's input path on EXR files. The file goes the way
-// build/bin/ssao takes its --input (core/cli/app.cpp load_inputs): ssao_tools::read_image
-// (OpenImageIO in the module libssao_image_codec.so), linearize, detect_passes on its channel
-// names, extract_channels of depth, normal and beauty, and, for small images, a run of the
-// library on them. Everything must either work or throw ssao_tools::Error; an image that reads must
-// be consistent (as many floats as width x height x channels, the passes chosen exist).
+// build/bin/ssao takes its --input (core/cli/app.cpp load_inputs): ssao_tools::read_channels
+// (OpenImageIO in the module libssao_image_codec.so) of the passes detect_passes chooses, each
+// straight into its buffer, and, for small images, a run of the library on them. Its oracle is
+// the whole image: read_image (every channel), linearize, detect_passes on its channel names,
+// extract_channels of depth, normal and beauty; read_channels must give these bit for bit.
+// Everything must either work or throw ssao_tools::Error; an image that reads must be
+// consistent (as many floats as width x height x channels, the passes chosen exist).
 //
 // The file is made from the input, in one of two ways:
 // - structured (what the fuzzer explores): the input chooses what an EXR can hold and
@@ -181,7 +183,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
         "the display window is not inside the data window read");
   check(image.pixels.size() == image.pixel_count() * size_t(image.channels()),
         "pixel buffer does not match width x height x channels");
-  ssao_tools::linearize(image);
+  const bool linearized = ssao_tools::linearize(image);
 
   ssao_tools::PassChannels passes;
   try {
@@ -206,6 +208,48 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     check(false, "a channel detect_passes chose does not exist");
   }
   check(depth.size() == image.pixel_count(), "depth size");
+
+  // The CLI's way: only those channels, each pass into its own buffer.
+  ssao_tools::FloatBuffer read_depth, read_normal, read_beauty;
+  try {
+    const ssao_tools::Image header = ssao_tools::read_channels(
+        path, ssao_tools::Overscan::read, [&](const ssao_tools::Image& h) {
+          check(h.channel_names == image.channel_names, "read_channels: other channel names");
+          std::vector<ssao_tools::ChannelTarget> targets;
+          const auto pass = [&](const std::vector<std::string>& names,
+                                ssao_tools::FloatBuffer& buffer) {
+            const int n = static_cast<int>(names.size());
+            ssao_tools::resize_pass_buffer(buffer, h, n, path);
+            for (int c = 0; c < n; ++c) {
+              targets.push_back({ssao_tools::require_channel(h, names[size_t(c)], path),
+                                 buffer.data() + c, n, std::ptrdiff_t(n) * h.width});
+            }
+          };
+          pass({passes.depth}, read_depth);
+          if (!passes.normal.empty()) pass(passes.normal, read_normal);
+          if (!passes.beauty.empty()) pass(passes.beauty, read_beauty);
+          return targets;
+        });
+    check(header.width == image.width && header.height == image.height &&
+              header.frame_x == image.frame_x && header.frame_y == image.frame_y &&
+              header.frame_width == image.frame_width &&
+              header.frame_height == image.frame_height && header.pixels.empty(),
+          "read_channels: another header than read_image's");
+  } catch (const ssao_tools::Error& e) {
+    std::fprintf(stderr, "fuzz_exr: read_channels refused what read_image read: %s\n", e.what());
+    std::abort();
+  }
+  const auto same_bits = [](const std::vector<float>& a, const ssao_tools::FloatBuffer& b) {
+    return a.size() == b.size() &&
+           (a.empty() || std::memcmp(a.data(), b.data(), a.size() * sizeof(float)) == 0);
+  };
+  // linearize() changed every channel but alpha (the CLI reads them as stored): compared for a
+  // file stored linear only.
+  if (!linearized) {
+    check(same_bits(depth, read_depth) && same_bits(normal, read_normal) &&
+              same_bits(beauty, read_beauty),
+          "read_channels: a pass differs from read_image's");
+  }
 
   // The library on what was read, as the CLI attaches it (small images only: speed).
   if (image.frame_pixel_count() == 0 || image.pixel_count() > 4096) return 0;
