@@ -112,17 +112,21 @@ Inputs load_inputs(const Options& options) {
   return in;
 }
 
+// Attaches the inputs and the outputs to the job; every image the job may still hold from a frame
+// before and this one lacks is detached.
 void attach_images(ssao::api::Job& job, Inputs& in, Outputs& out) {
   const ssao_tools::Image& image = in.image;
   job.set_image("depth", in.depth.data(), image.width, image.height, 1);
-  if (!in.normal.empty()) job.set_image("normal", in.normal.data(), image.width, image.height, 3);
-  for (size_t k = 0; k < in.layer_depth.size(); ++k) {
+  job.set_image("normal", in.normal.empty() ? nullptr : in.normal.data(), image.width, image.height,
+                3);
+  for (size_t k = 0; k < ssao_tools::kMaxDepthLayers; ++k) {
     const std::string hit = std::to_string(k + 2);
-    job.set_image(("depth" + hit).c_str(), in.layer_depth[k].data(), image.width, image.height, 1);
-    if (!in.layer_facing[k].empty()) {
-      job.set_image(("facing" + hit).c_str(), in.layer_facing[k].data(), image.width, image.height,
-                    1);
-    }
+    const bool has_layer = k < in.layer_depth.size();
+    const bool has_facing = has_layer && !in.layer_facing[k].empty();
+    job.set_image(("depth" + hit).c_str(), has_layer ? in.layer_depth[k].data() : nullptr,
+                  image.width, image.height, 1);
+    job.set_image(("facing" + hit).c_str(), has_facing ? in.layer_facing[k].data() : nullptr,
+                  image.width, image.height, 1);
   }
   // The outputs are the frame; the beauty is read in place, the frame's window of the data.
   const int w = image.frame_width, h = image.frame_height;
@@ -135,6 +139,9 @@ void attach_images(ssao::api::Job& job, Inputs& in, Outputs& out) {
     const ssao_tools::FrameView beauty = ssao_tools::frame_view(image, in.beauty, channels);
     job.set_image("beauty", beauty.data, w, h, channels, beauty.pixel_stride, beauty.row_stride);
     job.set_image("composite", out.composite.data(), w, h, channels);
+  } else {
+    job.set_image("beauty", nullptr, 0, 0, 1);
+    job.set_image("composite", nullptr, 0, 0, 1);
   }
 }
 

@@ -386,6 +386,8 @@ class BackgroundDepthTest(CliTestCase):
 class SequenceTest(CliTestCase):
     """--frames: patterns, independent frames, --skip-existing, --progress json."""
 
+    LAYER_CHANNELS = property(lambda self: DepthLayersTest.LAYER_CHANNELS)  # for layer_planes
+
     def write_frames(self, frames, pattern="in.{:04d}.exr"):
         """Frames whose box sits at a different depth each (so that they differ)."""
         for frame in frames:
@@ -428,6 +430,32 @@ class SequenceTest(CliTestCase):
             if previous is not None:
                 self.assertFalse(np.array_equal(ao, previous), "frames should differ")
             previous = ao
+
+    def test_sequence_frames_with_other_passes_and_sizes(self):
+        # Buffers pass from frame to frame, and the job from run to run: a frame without
+        # normals, layers or alpha after one with them, and a smaller frame between larger
+        # ones, must each be what a run on that file alone writes.
+        layers = DepthLayersTest.layer_planes(self)
+        no_normals = [n for n in BLENDER_CHANNELS if ".Normal." not in n and n[-2:] != ".A"]
+        small = {n: v[4:40, 8:56] for n, v in layers.items()}
+        frames = {1: (layers, sorted(layers)), 2: (self.planes, no_normals),
+                  3: (small, sorted(small)), 4: (layers, sorted(layers)),
+                  5: (self.planes, BLENDER_CHANNELS)}
+        for frame, (planes, names) in frames.items():
+            write_exr(self.path(f"in.{frame:04d}.exr"), planes, names)
+        for args in ((), ("--ao-only",)):
+            proc = self.run_ssao(self.path("in.####.exr"), "-o", self.path("out.####.exr"),
+                                 "--camera", self.camera, "--radius", RADIUS, "--frames", "1-5",
+                                 *args, default_paths=False)
+            self.assertEqual(proc.returncode, 0, proc.stderr)
+            for frame in frames:
+                alone = self.path(f"alone.{frame}.exr")
+                proc = self.run_ssao(self.path(f"in.{frame:04d}.exr"), "-o", alone, "--camera",
+                                     self.camera, "--radius", RADIUS, *args, default_paths=False)
+                self.assertEqual(proc.returncode, 0, proc.stderr)
+                got, expected = read_image(self.path(f"out.{frame:04d}.exr")), read_image(alone)
+                self.assertEqual(got[0], expected[0], f"frame {frame} {args}")
+                np.testing.assert_array_equal(got[1], expected[1], f"frame {frame} {args}")
 
     def test_skip_existing_and_json_progress(self):
         self.write_frames([1, 2, 3])
