@@ -908,8 +908,12 @@ class Scanner {
         CameraSource camera;
         camera.kind = block ? CameraSource::kBlock : CameraSource::kSSAOCameraMacro;
         // A block without its braces; the macro's arguments with their parentheses.
-        camera.tokens.assign(tokens.begin() + static_cast<long>(i) + (block ? 2 : 1),
-                             tokens.begin() + static_cast<long>(end) - (block ? 1 : 0));
+        // An unclosed group ends at the end of the tokens, without a closing brace to drop:
+        // never a range that ends before it starts (found by fuzz_pov_scene: "camera {").
+        const size_t first = i + (block ? 2 : 1);
+        const size_t last = std::max(first, end - (block ? 1 : 0));
+        camera.tokens.assign(tokens.begin() + static_cast<long>(first),
+                             tokens.begin() + static_cast<long>(last));
         camera.location = where(token);
         camera.conditional = conditionals_.unknown_depth() > 0;
         camera.symbols = symbols_;
