@@ -23,17 +23,18 @@ namespace {
 
 namespace fs = std::filesystem;
 
-// The input image with the passes the core reads, each tightly packed. With overscan (an EXR
-// whose data window is larger than its display window) the passes hold the whole data window:
-// the AO of the frame (image.frame_*) is computed from all of it.
+// The input image's header and the passes the core reads, each tightly packed, read from the
+// file straight into these buffers (the file's other channels are not read). With overscan (an
+// EXR whose data window is larger than its display window) the passes hold the whole data
+// window: the AO of the frame (image.frame_*) is computed from all of it.
 struct Inputs {
-  ssao_tools::Image image;
+  ssao_tools::Image image;  // no pixels
   ssao_tools::PassChannels passes;
-  std::vector<float> depth;   // 1 channel
-  std::vector<float> normal;  // 3 channels or empty
-  std::vector<float> beauty;  // 3 or 4 channels or empty
+  ssao_tools::FloatBuffer depth;   // 1 channel
+  ssao_tools::FloatBuffer normal;  // 3 channels or empty
+  ssao_tools::FloatBuffer beauty;  // 3 or 4 channels or empty
   // The 2nd, 3rd, ... hit's depth, 1 channel each, and its facing (empty when not given).
-  std::vector<std::vector<float>> layer_depth, layer_facing;
+  std::vector<ssao_tools::FloatBuffer> layer_depth, layer_facing;
   int beauty_channels() const { return static_cast<int>(passes.beauty.size()); }
 };
 
@@ -76,9 +77,25 @@ ssao_tools::Camera load_camera(const Options& options) {
   return camera;
 }
 
+// The channels the run reads: the passes found (or named) among the file's channels.
+ssao_tools::PassChannels choose_passes(const Options& options, const ssao_tools::Image& header,
+                                       const ssao_tools::PassOverrides& overrides) {
+  ssao_tools::PassChannels passes =
+      ssao_tools::detect_passes(header.channel_names, overrides, options.input);
+  if (options.ao_only) passes.beauty.clear();
+  if (!options.ao_only && passes.beauty.empty()) {
+    throw ssao_tools::Error(
+        "'" + options.input + "' has no beauty pass (looked for " +
+        (passes.layer.empty() ? "" : passes.layer + ".") +
+        "Combined.R/G/B); use --ao-only to write AO alone, or name the beauty " +
+        "channels with --beauty-channels R,G,B[,A]");
+  }
+  return passes;
+}
+
+// Reads the passes the run needs from options.input, each into its own buffer of `in`.
 Inputs load_inputs(const Options& options) {
   Inputs in;
-  in.image = ssao_tools::read_image(options.input, ssao_tools::Overscan::read);
   ssao_tools::PassOverrides overrides;
   overrides.layer = options.layer;
   overrides.depth_channel = options.depth_channel;
@@ -87,28 +104,34 @@ Inputs load_inputs(const Options& options) {
   overrides.no_normals = options.no_normals;
   overrides.depth_layers = options.depth_layers;
   overrides.no_depth_layers = options.no_depth_layers;
-  in.passes = ssao_tools::detect_passes(in.image.channel_names, overrides, options.input);
-  if (options.ao_only) in.passes.beauty.clear();
-  if (!options.ao_only && in.passes.beauty.empty()) {
-    throw ssao_tools::Error(
-        "'" + options.input + "' has no beauty pass (looked for " +
-        (in.passes.layer.empty() ? "" : in.passes.layer + ".") +
-        "Combined.R/G/B); use --ao-only to write AO alone, or name the beauty " +
-        "channels with --beauty-channels R,G,B[,A]");
-  }
-
-  const auto pass = [&](const std::vector<std::string>& names) {
-    return ssao_tools::extract_named_channels(in.image, names, options.input);
+  const auto choose = [&](const ssao_tools::Image& header) {
+    in.image = header;
+    in.passes = choose_passes(options, header, overrides);
+    std::vector<ssao_tools::ChannelTarget> targets;
+    const auto pass = [&](const std::vector<std::string>& names, ssao_tools::FloatBuffer& buffer) {
+      const int channels = static_cast<int>(names.size());
+      ssao_tools::resize_pass_buffer(buffer, header, channels, options.input);
+      for (int c = 0; c < channels; ++c) {
+        targets.push_back({ssao_tools::require_channel(header, names[size_t(c)], options.input),
+                           buffer.data() + c, channels, std::ptrdiff_t(channels) * header.width});
+      }
+    };
+    pass({in.passes.depth}, in.depth);
+    in.normal.clear();
+    in.beauty.clear();
+    if (!in.passes.normal.empty()) pass(in.passes.normal, in.normal);
+    if (!in.passes.beauty.empty()) pass(in.passes.beauty, in.beauty);
+    in.layer_depth.resize(in.passes.depth_layers.size());
+    in.layer_facing.resize(in.passes.depth_layers.size());
+    for (size_t k = 0; k < in.passes.depth_layers.size(); ++k) {
+      const ssao_tools::DepthLayerChannels& layer = in.passes.depth_layers[k];
+      pass({layer.depth}, in.layer_depth[k]);
+      in.layer_facing[k].clear();
+      if (!layer.facing.empty()) pass({layer.facing}, in.layer_facing[k]);
+    }
+    return targets;
   };
-  in.depth = pass({in.passes.depth});
-  if (!in.passes.normal.empty()) in.normal = pass(in.passes.normal);
-  if (!in.passes.beauty.empty()) in.beauty = pass(in.passes.beauty);
-  for (const ssao_tools::DepthLayerChannels& layer : in.passes.depth_layers) {
-    in.layer_depth.push_back(pass({layer.depth}));
-    in.layer_facing.push_back(layer.facing.empty() ? std::vector<float>() : pass({layer.facing}));
-  }
-  in.image.pixels.clear();
-  in.image.pixels.shrink_to_fit();
+  ssao_tools::read_channels(options.input, ssao_tools::Overscan::read, choose);
   return in;
 }
 
@@ -136,7 +159,7 @@ void attach_images(ssao::api::Job& job, Inputs& in, Outputs& out) {
   if (!in.beauty.empty()) {
     const int channels = in.beauty_channels();
     out.composite.assign(image.frame_pixel_count() * size_t(channels), 0.0f);
-    const ssao_tools::FrameView beauty = ssao_tools::frame_view(image, in.beauty, channels);
+    const ssao_tools::FrameView beauty = ssao_tools::frame_view(image, in.beauty.data(), channels);
     job.set_image("beauty", beauty.data, w, h, channels, beauty.pixel_stride, beauty.row_stride);
     job.set_image("composite", out.composite.data(), w, h, channels);
   } else {

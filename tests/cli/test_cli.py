@@ -715,6 +715,193 @@ class DepthLayersTest(CliTestCase):
                           1, "'depth2' at pixel (30, 30) is nearer than 'depth'")
 
 
+class ChannelReadTest(CliTestCase):
+    """The tool reads only the channels it uses, straight into its buffers (a production EXR
+    holds 30 and more; core/tools/image_codec.cpp read_channels): whatever else a file holds,
+    where its passes sit (other parts, between other channels, half or float, tiles, any
+    compression, overscan), the output is the one of a file holding just those passes."""
+
+    LAYER_CHANNELS = DepthLayersTest.LAYER_CHANNELS
+    # Names that sort before, between and after the passes the tool reads, as Blender's do.
+    EXTRA = ["ViewLayer.AO.R", "ViewLayer.AO.G", "ViewLayer.AO.B", "ViewLayer.DiffCol.R",
+             "ViewLayer.DiffCol.G", "ViewLayer.DiffCol.B", "ViewLayer.Emit.R", "ViewLayer.Emit.G",
+             "ViewLayer.Emit.B", "ViewLayer.IndexOB.X", "ViewLayer.Mist.Z", "ViewLayer.Vector.X",
+             "ViewLayer.Vector.Y", "ViewLayer.Vector.Z", "ViewLayer.Vector.W"]
+
+    def extra_planes(self, seed=3):
+        rng = np.random.default_rng(seed)
+        planes = {name: rng.normal(0.0, 5.0, (HEIGHT, WIDTH)).astype(np.float32)
+                  for name in self.EXTRA}
+        planes["ViewLayer.Mist.Z"][3, 4] = np.nan
+        return planes
+
+    def write(self, path, planes, names, formats=None, compression="zip", tile=None,
+              data_origin=None, display_size=None):
+        """An EXR with per-channel formats (default float), tiles and a data window."""
+        height, width = planes[names[0]].shape
+        spec = oiio.ImageSpec(width, height, len(names), oiio.FLOAT)
+        spec.channelnames = tuple(names)
+        spec.channelformats = tuple(formats.get(n, oiio.FLOAT) for n in names) if formats \
+            else ()
+        spec.alpha_channel = -1
+        spec.attribute("compression", compression)
+        if tile:
+            spec.tile_width = spec.tile_height = tile
+        if data_origin is not None:
+            spec.x, spec.y = data_origin
+            spec.full_x, spec.full_y = 0, 0
+            spec.full_width, spec.full_height = display_size
+        out = oiio.ImageOutput.create(path)
+        self.assertTrue(out is not None and out.open(path, spec), oiio.geterror())
+        self.assertTrue(out.write_image(np.stack([planes[n] for n in names], axis=-1)),
+                        out.geterror())
+        out.close()
+        return path
+
+    def write_parts(self, path, planes, data_origin=None, display_size=None):
+        """One part per pass (layer.pass), as Blender 5.x writes them: each part the tool reads
+        is read whole in one call, the simplest way there is; the reference of these tests."""
+        parts = {}
+        for name in planes:
+            parts.setdefault(name.rsplit(".", 1)[0], []).append(name)
+        specs = []
+        for part, names in parts.items():
+            height, width = planes[names[0]].shape
+            spec = oiio.ImageSpec(width, height, len(names), oiio.FLOAT)
+            spec.channelnames = tuple(names)
+            spec.attribute("name", part)
+            spec.attribute("compression", "zip")
+            if data_origin is not None:
+                spec.x, spec.y = data_origin
+                spec.full_x, spec.full_y = 0, 0
+                spec.full_width, spec.full_height = display_size
+            specs.append(spec)
+        out = oiio.ImageOutput.create(path)
+        self.assertTrue(out is not None and out.open(path, specs), oiio.geterror())
+        for i, names in enumerate(parts.values()):
+            if i:
+                self.assertTrue(out.open(path, specs[i], "AppendSubimage"), out.geterror())
+            self.assertTrue(out.write_image(np.stack([planes[n] for n in names], axis=-1)))
+        out.close()
+        return path
+
+    def outputs(self, path, *args, camera=None):
+        """(composite run, --ao-only run) of `path`, as arrays."""
+        got = []
+        for extra in ((), ("--ao-only",)):
+            output = self.path("out_%d.exr" % len(os.listdir(self.dir)))
+            proc = self.run_ssao(path, "-o", output, "--camera", camera or self.camera,
+                                 "--radius", RADIUS, *args, *extra, default_paths=False)
+            self.assertEqual(proc.returncode, 0, f"{self.last_command}\n{proc.stderr}")
+            got.append(read_image(output))
+        return got
+
+    def assert_same_outputs(self, got, expected, what):
+        for (names, pixels), (ref_names, ref_pixels) in zip(got, expected):
+            self.assertEqual(names, ref_names, what)
+            np.testing.assert_array_equal(pixels, ref_pixels, err_msg=what)
+
+    def test_extra_channels_formats_tiles_and_compressions_change_nothing(self):
+        layers = DepthLayersTest.layer_planes(self)
+        expected = self.outputs(self.write_parts(self.path("parts.exr"), layers))
+        planes = {**layers, **self.extra_planes()}
+        names = sorted(planes)  # the passes interleaved with the others
+        half = {n: oiio.HALF for n in self.EXTRA}
+        cases = [("zip", {}, None), ("zip", half, None), ("zips", half, None),
+                 ("piz", half, None), ("none", {}, None), ("rle", half, None),
+                 ("zip", half, 16), ("piz", {}, 32)]
+        for compression, formats, tile in cases:
+            what = f"{compression}, {'half' if formats else 'float'} extras, tiles {tile}"
+            with self.subTest(what):
+                path = self.write(self.path(f"{compression}_{len(formats)}_{tile}.exr"), planes,
+                                  names, formats, compression, tile)
+                self.assert_same_outputs(self.outputs(path), expected, what)
+        # Just the passes, next to each other in the file.
+        self.assert_same_outputs(self.outputs(self.write(self.path("needed.exr"), layers,
+                                                         sorted(layers))), expected, "needed")
+        # Named channels in another order than the file's: the colour channels swapped.
+        path = self.write(self.path("named.exr"), planes, names, half)
+        got = self.outputs(path, "--beauty-channels",
+                           "ViewLayer.Combined.B,ViewLayer.Combined.G,ViewLayer.Combined.R")
+        swapped = dict(layers)
+        del swapped["ViewLayer.Combined.A"]
+        swapped["ViewLayer.Combined.R"], swapped["ViewLayer.Combined.B"] = (
+            layers["ViewLayer.Combined.B"], layers["ViewLayer.Combined.R"])
+        self.assert_same_outputs(got, self.outputs(self.write_parts(self.path("swapped.exr"),
+                                                                    swapped)), "B,G,R")
+        # Two passes of the same width next to each other in the file (a layer's depth, then
+        # its facing): each into its own buffer.
+        plain = {"Combined.R": layers["ViewLayer.Combined.R"],
+                 "Combined.G": layers["ViewLayer.Combined.G"],
+                 "Combined.B": layers["ViewLayer.Combined.B"],
+                 "Depth.Z": layers["ViewLayer.Depth.Z"], "hit2": layers["ViewLayer.Depth2.Z"],
+                 "hit2b": layers["ViewLayer.Facing2.V"]}
+        path = self.write(self.path("adjacent.exr"), plain, sorted(plain))
+        got = self.outputs(path, "--no-normals", "--depth-layer", "hit2:hit2b")
+        reference = self.write_parts(self.path("adjacent_parts.exr"), plain)
+        self.assert_same_outputs(got, self.outputs(reference, "--no-normals", "--depth-layer",
+                                                   "hit2:hit2b"), "hit2:hit2b")
+
+    def test_passes_in_other_parts_of_a_multi_part_file(self):
+        layers = DepthLayersTest.layer_planes(self)
+        expected = self.outputs(self.write_parts(self.path("parts.exr"), layers))
+        # Parts in this order: others first, the passes the tool reads scattered among them,
+        # several passes in one part.
+        extra = self.extra_planes()
+        order = [["ViewLayer.AO", "ViewLayer.Vector"], ["ViewLayer.Normal"], ["ViewLayer.Mist"],
+                 ["ViewLayer.Facing2", "ViewLayer.Combined", "ViewLayer.DiffCol"],
+                 ["ViewLayer.Depth3"], ["ViewLayer.Depth", "ViewLayer.Facing3", "ViewLayer.Emit"],
+                 ["ViewLayer.Depth2", "ViewLayer.IndexOB"]]
+        everything = {**layers, **extra}
+        specs, groups = [], []
+        for part in order:
+            names = [n for n in sorted(everything) if n.rsplit(".", 1)[0] in part]
+            spec = oiio.ImageSpec(WIDTH, HEIGHT, len(names), oiio.FLOAT)
+            spec.channelnames = tuple(names)
+            spec.channelformats = tuple(oiio.HALF if n in extra else oiio.FLOAT for n in names)
+            spec.attribute("name", part[0])
+            spec.attribute("compression", "zip")
+            specs.append(spec)
+            groups.append(names)
+        self.assertEqual(sum(len(g) for g in groups), len(everything))
+        multipart = self.path("multipart.exr")
+        out = oiio.ImageOutput.create(multipart)
+        self.assertTrue(out.open(multipart, specs), out.geterror())
+        for i, names in enumerate(groups):
+            if i:
+                self.assertTrue(out.open(multipart, specs[i], "AppendSubimage"), out.geterror())
+            self.assertTrue(out.write_image(np.stack([everything[n] for n in names], axis=-1)))
+        out.close()
+        self.assert_same_outputs(self.outputs(multipart), expected, "multi-part")
+
+    def test_overscan_and_other_formats(self):
+        band = OverscanTest.BAND
+        window = dict(data_origin=(-band, -band), display_size=(WIDTH - 2 * band,
+                                                                HEIGHT - 2 * band))
+        camera = self.write_camera(dict(CAMERA, sensor_width=CAMERA["sensor_width"] *
+                                        (WIDTH - 2 * band) / WIDTH), "frame_camera.json")
+        expected = self.outputs(self.write_parts(self.path("parts.exr"), self.planes, **window),
+                                camera=camera)
+        planes = {**self.planes, **self.extra_planes()}
+        for compression in ("zips", "zip"):
+            path = self.write(self.path(f"overscan_{compression}.exr"), planes, sorted(planes),
+                              {n: oiio.HALF for n in self.EXTRA}, compression, **window)
+            self.assert_same_outputs(self.outputs(path, camera=camera), expected,
+                                     f"overscan, {compression}")
+        # Not an EXR: a float TIFF (R, G, B, A and a 5th channel OpenImageIO names channel4).
+        tiff = self.path("in.tif")
+        names = ["ViewLayer.Combined." + c for c in "RGBA"] + ["ViewLayer.Depth.Z"]
+        spec = oiio.ImageSpec(WIDTH, HEIGHT, 5, oiio.FLOAT)
+        out = oiio.ImageOutput.create(tiff)
+        self.assertTrue(out.open(tiff, spec), oiio.geterror())
+        out.write_image(np.stack([self.planes[n] for n in names], axis=-1))
+        out.close()
+        exr = self.write_parts(self.path("rgbaz.exr"), {c: self.planes[n] for c, n in
+                                                        zip(["R", "G", "B", "A", "Z"], names)})
+        self.assert_same_outputs(self.outputs(tiff, "--depth-channel", "channel4"),
+                                 self.outputs(exr), "TIFF")
+
+
 class HelpTest(CliTestCase):
 
     def test_help_lists_every_parameter(self):
