@@ -632,9 +632,18 @@ def write_markdown(path, images, args, plan, rows, table, complexity, noise, mac
     if failed:
         lines[2:2] = ["", "**Incomplete run: %s failed (see the run's output).**"
                       % ", ".join(failed)]
+    # Sections that other benchmarks measure (after KEPT_MARKER) stay as they are.
+    if os.path.isfile(path):
+        with open(path, encoding="utf-8") as f:
+            old = f.read()
+        if KEPT_MARKER in old:
+            lines += ["", KEPT_MARKER + old.split(KEPT_MARKER, 1)[1].rstrip("\n")]
     with open(path + ".tmp", "w", encoding="utf-8") as f:
         f.write("\n".join(lines))
     os.replace(path + ".tmp", path)
+
+
+KEPT_MARKER = "<!-- Below: measured by other benchmarks; speed_error.py keeps it as it is. -->"
 
 
 METHOD_NOTES = """## How it is measured

@@ -38,10 +38,20 @@ struct Inputs {
   int beauty_channels() const { return static_cast<int>(passes.beauty.size()); }
 };
 
-// What the core writes.
+// One channel of an interleaved buffer, indexed by pixel.
+struct Channel {
+  const float* first = nullptr;
+  size_t stride = 1;
+  float operator[](size_t pixel) const { return first[pixel * stride]; }
+};
+
+// What the core writes, straight into the layout of the output file: R, G, B[, A] (the
+// composite, as many channels as the beauty) then AO, interleaved; AO alone with --ao-only.
+// Kept from one frame of a sequence to the next.
 struct Outputs {
-  std::vector<float> ao;         // 1 channel
-  std::vector<float> composite;  // as many channels as the beauty, empty with --ao-only
+  ssao_tools::FloatBuffer pixels;
+  std::vector<std::string> names;
+  Channel ao;
 };
 
 using ssao_tools::ProgressReporter;
@@ -93,9 +103,10 @@ ssao_tools::PassChannels choose_passes(const Options& options, const ssao_tools:
   return passes;
 }
 
-// Reads the passes the run needs from options.input, each into its own buffer of `in`.
-Inputs load_inputs(const Options& options) {
-  Inputs in;
+// Reads the passes the run needs from options.input, each into its own buffer of `in`; the
+// buffers of `recycled` (a frame before) are used again where they are large enough.
+Inputs load_inputs(const Options& options, Inputs recycled = Inputs()) {
+  Inputs in = std::move(recycled);
   ssao_tools::PassOverrides overrides;
   overrides.layer = options.layer;
   overrides.depth_channel = options.depth_channel;
@@ -135,8 +146,8 @@ Inputs load_inputs(const Options& options) {
   return in;
 }
 
-// Attaches the inputs and the outputs to the job; every image the job may still hold from a frame
-// before and this one lacks is detached.
+// Attaches the inputs and the outputs (allocated here, or kept from the frame before) to the job;
+// every image the job may still hold from a frame before and this one lacks is detached.
 void attach_images(ssao::api::Job& job, Inputs& in, Outputs& out) {
   const ssao_tools::Image& image = in.image;
   job.set_image("depth", in.depth.data(), image.width, image.height, 1);
@@ -151,17 +162,25 @@ void attach_images(ssao::api::Job& job, Inputs& in, Outputs& out) {
     job.set_image(("facing" + hit).c_str(), has_facing ? in.layer_facing[k].data() : nullptr,
                   image.width, image.height, 1);
   }
-  // The outputs are the frame; the beauty is read in place, the frame's window of the data.
+  // The outputs are the frame, written by the core into the output file's layout; the beauty is
+  // read in place, the frame's window of the data.
   const int w = image.frame_width, h = image.frame_height;
   job.set_output_window(image.has_overscan(), image.frame_x, image.frame_y);
-  out.ao.assign(image.frame_pixel_count(), 0.0f);
-  job.set_image("ao", out.ao.data(), w, h, 1);
-  if (!in.beauty.empty()) {
-    const int channels = in.beauty_channels();
-    out.composite.assign(image.frame_pixel_count() * size_t(channels), 0.0f);
-    const ssao_tools::FrameView beauty = ssao_tools::frame_view(image, in.beauty.data(), channels);
-    job.set_image("beauty", beauty.data, w, h, channels, beauty.pixel_stride, beauty.row_stride);
-    job.set_image("composite", out.composite.data(), w, h, channels);
+  const int colour = in.beauty_channels();  // 0 with --ao-only
+  const size_t stride = size_t(colour) + 1;
+  out.names = {"R", "G", "B", "A"};
+  out.names.resize(size_t(colour));
+  out.names.push_back("AO");
+  const size_t count = image.frame_pixel_count() * stride;
+  if (count > out.pixels.capacity()) out.pixels = ssao_tools::FloatBuffer();  // nothing to copy
+  out.pixels.resize(count);  // the core writes every value
+  const std::ptrdiff_t pixel_bytes = std::ptrdiff_t(stride * sizeof(float));
+  out.ao = {out.pixels.data() + colour, stride};
+  job.set_image("ao", out.pixels.data() + colour, w, h, 1, pixel_bytes, pixel_bytes * w);
+  if (colour > 0) {
+    const ssao_tools::FrameView beauty = ssao_tools::frame_view(image, in.beauty.data(), colour);
+    job.set_image("beauty", beauty.data, w, h, colour, beauty.pixel_stride, beauty.row_stride);
+    job.set_image("composite", out.pixels.data(), w, h, colour, pixel_bytes, pixel_bytes * w);
   } else {
     job.set_image("beauty", nullptr, 0, 0, 1);
     job.set_image("composite", nullptr, 0, 0, 1);
@@ -197,27 +216,15 @@ double compute_ao(ssao::api::Job& job, bool quiet) {
   return std::chrono::duration<double, std::milli>(stop - start).count();
 }
 
-// The output file's channels: beauty's (named R, G, B[, A]) x AO then AO, or AO alone.
+// The output file's channels: beauty's (named R, G, B[, A]) x AO then AO, or AO alone; the core
+// wrote them in the file's layout.
 void write_output(const Options& options, const Inputs& in, const Outputs& out) {
-  const auto write = ssao_tools::is_preview_path(options.output) ? ssao_tools::write_preview
-                                                                 : ssao_tools::write_exr;
-  const size_t pixels = in.image.frame_pixel_count();
   const int width = in.image.frame_width, height = in.image.frame_height;
-  if (out.composite.empty()) {
-    write(options.output, width, height, {"AO"}, out.ao);
-    return;
+  if (ssao_tools::is_preview_path(options.output)) {
+    ssao_tools::write_preview_pixels(options.output, width, height, out.names, out.pixels.data());
+  } else {
+    ssao_tools::write_exr_pixels(options.output, width, height, out.names, out.pixels.data());
   }
-  std::vector<std::string> names = {"R", "G", "B", "A"};
-  const size_t beauty = static_cast<size_t>(in.beauty_channels());
-  names.resize(beauty);
-  names.push_back("AO");
-  const size_t stride = beauty + 1;
-  std::vector<float> interleaved(pixels * stride);
-  for (size_t p = 0; p < pixels; ++p) {
-    for (size_t c = 0; c < beauty; ++c) interleaved[p * stride + c] = out.composite[p * beauty + c];
-    interleaved[p * stride + beauty] = out.ao[p];
-  }
-  write(options.output, width, height, names, interleaved);
 }
 
 // The same test as the core's: finite, > 0, below background_depth and clip_end (when > 0).
@@ -354,16 +361,21 @@ void run_sequence(const Options& options) {
 
   ProgressReporter interrupt(true);  // Ctrl-C stops after the frame in progress
   ssao::api::Job job;
+  Outputs out;  // its buffer serves every frame of the size
   const size_t total = options.frames.size();
   std::vector<int> failed;
   size_t written = 0, skipped = 0;
   const auto start = std::chrono::steady_clock::now();
   double compute_seconds = 0.0;
 
-  auto load = [](Options o) {
+  // A frame's buffers serve the frame after next (the next one is read while this one computes):
+  // the same memory, no new pages to fault in. The job points at them until attach_images
+  // replaces every image of the frame after, before it runs again.
+  Inputs spare;
+  auto load = [](Options o, Inputs recycled) {
     FrameInputs f;
     f.camera = load_camera(o);
-    f.in = load_inputs(o);
+    f.in = load_inputs(o, std::move(recycled));
     return f;
   };
   auto wanted = [&](size_t i) {
@@ -374,7 +386,9 @@ void run_sequence(const Options& options) {
     while (i < total && !wanted(i)) ++i;  // skipped frames are not read
     if (i < total) {
       next = std::async(std::launch::async, load,
-                        frame_options(options, input, output, camera, options.frames[i]));
+                        frame_options(options, input, output, camera, options.frames[i]),
+                        std::move(spare));
+      spare = Inputs();
     }
     return i;
   };
@@ -397,7 +411,6 @@ void run_sequence(const Options& options) {
         check_output_folder(o);
         ssao_tools::apply_camera(job.get(), f.camera, o.camera);
         ssao_tools::apply_params(job, o.params);
-        Outputs out;
         attach_images(job, f.in, out);
         require_camera_for_normals(job, f.in, f.camera, o.camera);
         choose_radius(o, f.camera, job);
@@ -412,6 +425,7 @@ void run_sequence(const Options& options) {
         size_t count = 0;
         mean = mean_ao(job, f.in, out, count);
         ++written;
+        spare = std::move(f.in);
       } catch (const std::exception& e) {
         status = "failed";
         error = e.what();
