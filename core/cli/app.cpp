@@ -38,20 +38,12 @@ struct Inputs {
   int beauty_channels() const { return static_cast<int>(passes.beauty.size()); }
 };
 
-// One channel of an interleaved buffer, indexed by pixel.
-struct Channel {
-  const float* first = nullptr;
-  size_t stride = 1;
-  float operator[](size_t pixel) const { return first[pixel * stride]; }
-};
-
 // What the core writes, straight into the layout of the output file: R, G, B[, A] (the
 // composite, as many channels as the beauty) then AO, interleaved; AO alone with --ao-only.
 // Kept from one frame of a sequence to the next.
 struct Outputs {
   ssao_tools::FloatBuffer pixels;
   std::vector<std::string> names;
-  Channel ao;
 };
 
 using ssao_tools::ProgressReporter;
@@ -175,7 +167,6 @@ void attach_images(ssao::api::Job& job, Inputs& in, Outputs& out) {
   if (count > out.pixels.capacity()) out.pixels = ssao_tools::FloatBuffer();  // nothing to copy
   out.pixels.resize(count);  // the core writes every value
   const std::ptrdiff_t pixel_bytes = std::ptrdiff_t(stride * sizeof(float));
-  out.ao = {out.pixels.data() + colour, stride};
   job.set_image("ao", out.pixels.data() + colour, w, h, 1, pixel_bytes, pixel_bytes * w);
   if (colour > 0) {
     const ssao_tools::FrameView beauty = ssao_tools::frame_view(image, in.beauty.data(), colour);
@@ -227,38 +218,20 @@ void write_output(const Options& options, const Inputs& in, const Outputs& out) 
   }
 }
 
-// The same test as the core's: finite, > 0, below background_depth and clip_end (when > 0).
-bool is_geometry(float depth, double background_depth, double clip_end) {
-  return std::isfinite(depth) && depth > 0.0f && depth < background_depth &&
-         (clip_end <= 0.0 || depth < clip_end);
-}
-
-// Mean AO over the frame's geometry pixels ("n/a" without any) and their count.
-std::string mean_ao(const ssao::api::Job& job, const Inputs& in, const Outputs& out,
-                    size_t& count) {
-  const double background_depth = job.get_float("background_depth");
-  const double clip_end = job.get_float("clip_end");
-  const ssao_tools::Image& image = in.image;
-  double sum = 0.0;
-  count = 0;
-  for (int y = 0; y < image.frame_height; ++y) {
-    for (int x = 0; x < image.frame_width; ++x) {
-      const float depth =
-          in.depth[size_t(y + image.frame_y) * size_t(image.width) + size_t(x + image.frame_x)];
-      if (!is_geometry(depth, background_depth, clip_end)) continue;
-      sum += out.ao[size_t(y) * size_t(image.frame_width) + size_t(x)];
-      ++count;
-    }
-  }
+// Mean AO over the frame's geometry pixels ("n/a" without any) and their count: what the
+// library's background rule counted in the last run (ssao_job_last_run).
+std::string mean_ao(const ssao::api::Job& job, size_t& count) {
+  const ssao::api::Job::RunStats stats = job.last_run();
+  count = stats.geometry_pixels;
   char mean[64] = "n/a";
-  if (count > 0) std::snprintf(mean, sizeof mean, "%.4f", sum / static_cast<double>(count));
+  if (count > 0) std::snprintf(mean, sizeof mean, "%.4f", stats.mean_ao);
   return mean;
 }
 
 void print_summary(const Options& options, const ssao::api::Job& job, const Inputs& in,
-                   const Outputs& out, double milliseconds) {
+                   double milliseconds) {
   size_t count = 0;
-  const std::string mean = mean_ao(job, in, out, count);
+  const std::string mean = mean_ao(job, count);
   std::fprintf(stderr,
                "ssao: %s: %dx%d, variant %s, normals %s, depth layers %zu, %.1f ms, mean AO %s "
                "over %zu geometry pixels\n",
@@ -423,7 +396,7 @@ void run_sequence(const Options& options) {
         ssao::api::check_status(result, "SSAO failed");
         write_output(o, f.in, out);
         size_t count = 0;
-        mean = mean_ao(job, f.in, out, count);
+        mean = mean_ao(job, count);
         ++written;
         spare = std::move(f.in);
       } catch (const std::exception& e) {
@@ -520,7 +493,7 @@ void run_ssao(const Options& options) {
   choose_radius(options, camera, job);
   const double milliseconds = compute_ao(job, options.quiet);
   write_output(options, in, out);
-  if (!options.quiet) print_summary(options, job, in, out, milliseconds);
+  if (!options.quiet) print_summary(options, job, in, milliseconds);
 }
 
 }  // namespace ssao_cli

@@ -18,6 +18,7 @@ import ctypes
 import json
 import math
 import os
+import re
 import shutil
 import subprocess
 import sys
@@ -354,6 +355,60 @@ class GoodRunTest(CliTestCase):
         write_exr(self.input, planes)
         self.assert_fails(self.run_ssao(), 1, "--layer", "ViewLayer", "Other")
         self.assert_ok(self.run_ssao("--layer", "Other"))
+
+
+class CameraContractTest(CliTestCase):
+    """A camera file may give another renderer's camera: pinhole intrinsics or an OpenGL
+    projection matrix instead of Blender's lens and sensor (docs/conventions.md)."""
+
+    def ao_with(self, camera):
+        self.camera = self.write_camera(camera)
+        proc = self.run_ssao()
+        self.assert_ok(proc)
+        names, out = read_image(self.output)
+        match = re.search(r"mean AO ([0-9.]+) over (\d+) geometry pixels", proc.stderr)
+        self.assertIsNotNone(match, proc.stderr)
+        return out[:, :, names.index("AO")], float(match.group(1)), int(match.group(2))
+
+    def test_intrinsics_and_matrix_give_the_lens_cameras_ao(self):
+        shifted = dict(CAMERA, shift_x=0.1, shift_y=-0.05)
+        reference, mean, geometry = self.ao_with(shifted)
+        # The same camera in pixels: AUTO fit of a landscape image, the sensor across the width.
+        f = WIDTH * CAMERA["lens"] / CAMERA["sensor_width"]
+        cx, cy = WIDTH / 2 - 0.1 * WIDTH, HEIGHT / 2 - 0.05 * WIDTH
+        common = {k: CAMERA[k] for k in ("clip_start", "clip_end", "matrix_world")}
+        intrinsics = dict(common, type="PERSP", projection="intrinsics",
+                          intrinsics=[f, f, cx, cy])
+        matrix = [[2 * f / WIDTH, 0, 1 - 2 * cx / WIDTH, 0],
+                  [0, 2 * f / HEIGHT, 2 * cy / HEIGHT - 1, 0],
+                  [0, 0, -1.0002, -0.2], [0, 0, -1, 0]]
+        opengl = dict(common, projection="matrix", projection_matrix=matrix)
+        unshifted, _, _ = self.ao_with(CAMERA)
+        self.assertGreater(float(np.abs(unshifted - reference).max()), 1e-3)  # the shift shows
+        for name, camera in (("intrinsics", intrinsics), ("matrix", opengl)):
+            with self.subTest(camera=name):
+                ao, other_mean, other_geometry = self.ao_with(camera)
+                np.testing.assert_allclose(ao, reference, rtol=0, atol=1e-4)
+                self.assertAlmostEqual(other_mean, mean, places=3)
+                self.assertEqual(other_geometry, geometry)
+        self.assertEqual(geometry, int((self.planes["ViewLayer.Depth.Z"] < 1e9).sum()))
+
+    def test_a_contract_camera_needs_its_own_keys(self):
+        cases = [
+            ({"type": "PERSP", "projection": "intrinsics"}, "missing key 'intrinsics'"),
+            ({"projection": "matrix"}, "missing key 'projection_matrix'"),
+            ({"type": "PERSP", "projection": "intrinsics", "intrinsics": [50, 50, 32]},
+             "array of 4 numbers"),
+            ({"projection": "matrix", "matrix_world": CAMERA["matrix_world"],
+              "projection_matrix": [[1, 0.5, 0, 0], [0, 1, 0, 0], [0, 0, -1, -0.2],
+                                    [0, 0, -1, 0]]},
+             "skewed"),
+            ({"type": "PERSP", "projection": "pinhole"}, "'projection'"),
+        ]
+        for content, phrase in cases:
+            with self.subTest(phrase=phrase):
+                self.camera = self.write_camera(content)
+                self.assert_fails(self.run_ssao(), 1, phrase)
 
 
 class BackgroundDepthTest(CliTestCase):
