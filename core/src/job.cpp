@@ -104,34 +104,41 @@ struct Shaping {
   }
 };
 
-// Adds a row's geometry pixels (depth not background) and the sum of their AO to the counts.
-// Eight independent float sums (a row is at most a tile wide), so that the loop vectorises
-// without reassociating: the result does not depend on the vector width.
-SSAO_VECTORIZE void count_geometry_row(const float* __restrict depth, const float* __restrict ao,
-                                       int count, size_t& geometry, double& sum) {
-  constexpr int kLanes = 8;
-  float lane_sum[kLanes] = {};
-  int lane_count[kLanes] = {};
-  int i = 0;
-  for (; i + kLanes <= count; i += kLanes) {
-    for (int k = 0; k < kLanes; ++k) {  // loads outside the condition: a select, no branch
-      const float value = ao[i + k];
-      const bool surface = depth[i + k] < Frame::kBackground;
-      lane_sum[k] += surface ? value : 0.0f;
-      lane_count[k] += surface ? 1 : 0;
+// The geometry pixels (depth not background) of a tile's rows and the sum of their AO, for
+// ssao_job_last_run. Eight float lanes as a GNU vector (one AVX register, two SSE ones): a fixed
+// lane structure, so the sums do not depend on the instruction set, and no reassociation.
+class GeometryCounter {
+ public:
+  SSAO_VECTORIZE void add_row(const float* depth, const float* ao, int count) {
+    int i = 0;
+    for (; i + kLanes <= count; i += kLanes) {
+      Floats d, value;
+      std::memcpy(&d, depth + i, sizeof d);
+      std::memcpy(&value, ao + i, sizeof value);
+      const Ints surface = d < Frame::kBackground;                // -1 (all bits) or 0 per lane
+      sum_ += value * __builtin_convertvector(-surface, Floats);  // AO is finite: x * 0 = 0
+      count_ -= surface;
+    }
+    for (int k = 0; i < count; ++i, ++k) {
+      const bool surface = depth[i] < Frame::kBackground;
+      sum_[k] += surface ? ao[i] : 0.0f;
+      count_[k] += surface ? 1 : 0;
     }
   }
-  for (int k = 0; i < count; ++i, ++k) {
-    const float value = ao[i];
-    const bool surface = depth[i] < Frame::kBackground;
-    lane_sum[k] += surface ? value : 0.0f;
-    lane_count[k] += surface ? 1 : 0;
+  void add_to(size_t& geometry, double& sum) const {
+    for (int k = 0; k < kLanes; ++k) {
+      sum += double(sum_[k]);
+      geometry += size_t(count_[k]);
+    }
   }
-  for (int k = 0; k < kLanes; ++k) {
-    sum += double(lane_sum[k]);
-    geometry += size_t(lane_count[k]);
-  }
-}
+
+ private:
+  static constexpr int kLanes = 8;
+  typedef float Floats __attribute__((vector_size(kLanes * sizeof(float))));
+  typedef int32_t Ints __attribute__((vector_size(kLanes * sizeof(int32_t))));
+  Floats sum_ = {};
+  Ints count_ = {};
+};
 
 // Pixels [x, x + count) of row y of `out` from the AO of a row: grey in the first three
 // channels, alpha 1. The pointer steps by the pixel stride (a multiple of 4 bytes).
@@ -529,19 +536,21 @@ void Job::run() {
     const Tile t{output.x0 + dx, output.y0 + dy, output.x1 + dx, output.y1 + dy};
     ScratchVector<float> denoised(size_t(t.x1 - t.x0) * size_t(t.y1 - t.y0));
     ScratchVector<float> coverage(composite_out_.attached() ? size_t(t.x1 - t.x0) : 0);
-    if (!frame.has_geometry(t.x0, t.y0, t.x1, t.y1)) {
-      std::fill(denoised.begin(), denoised.end(), 1.0f);  // sky
+    const bool sky = !frame.has_geometry(t.x0, t.y0, t.x1, t.y1);
+    if (sky) {
+      std::fill(denoised.begin(), denoised.end(), 1.0f);
     } else if (half_resolution) {
       upsample(frame, half_frame_, visibility.data(), denoiser, radius, t, denoised.data());
     } else {
       denoiser.vertical_pass(visibility.data(), t, denoised.data());
     }
     const int count = t.x1 - t.x0;
+    GeometryCounter geometry;
     for (int y = t.y0; y < t.y1; ++y) {
       float* values = denoised.data() + size_t(y - t.y0) * count;
       const float* depth = frame.depth_plane() + frame.index(t.x0, y);
       shaping.apply(depth, values, count);
-      count_geometry_row(depth, values, count, stats.geometry_pixels, stats.mean_ao);  // a sum
+      if (!sky) geometry.add_row(depth, values, count);
       if (ao_out_.attached()) write_ao_row(values, count, ao_out_, t.x0 - dx, y - dy);
       if (composite_out_.attached()) {
         coverage_row(frame, normal_, beauty_, t.x0, t.x1, y, dx, dy, coverage.data());
@@ -549,6 +558,7 @@ void Job::run() {
                       y - dy);
       }
     }
+    geometry.add_to(stats.geometry_pixels, stats.mean_ao);  // mean_ao holds the sum until below
   });
   RunStats total{0, 0.0};
   for (const RunStats& tile : tile_stats) {
