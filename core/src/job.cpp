@@ -125,6 +125,7 @@ class GeometryCounter {
       count_[k] += surface ? 1 : 0;
     }
   }
+  // Adds the lanes, in lane order, to a run's totals.
   void add_to(size_t& geometry, double& sum) const {
     for (int k = 0; k < kLanes; ++k) {
       sum += double(sum_[k]);
@@ -529,9 +530,13 @@ void Job::run() {
   // count.
   const int tiles_across = (window.x1 - dx + kTileWidth - 1) / kTileWidth;
   const int tiles_down = (window.y1 - dy + kTileHeight - 1) / kTileHeight;
-  std::vector<RunStats> tile_stats(size_t(tiles_across) * size_t(tiles_down), RunStats{0, 0.0});
+  struct Totals {
+    size_t geometry_pixels = 0;
+    double ao_sum = 0.0;
+  };
+  std::vector<Totals> tile_totals(size_t(tiles_across) * size_t(tiles_down));
   tiles.for_each_tile(window.x1 - dx, window.y1 - dy, uncancellable, [&](const Tile& output) {
-    RunStats& stats = tile_stats[size_t(output.y0 / kTileHeight) * size_t(tiles_across) +
+    Totals& totals = tile_totals[size_t(output.y0 / kTileHeight) * size_t(tiles_across) +
                                  size_t(output.x0 / kTileWidth)];
     const Tile t{output.x0 + dx, output.y0 + dy, output.x1 + dx, output.y1 + dy};
     ScratchVector<float> denoised(size_t(t.x1 - t.x0) * size_t(t.y1 - t.y0));
@@ -545,7 +550,7 @@ void Job::run() {
       denoiser.vertical_pass(visibility.data(), t, denoised.data());
     }
     const int count = t.x1 - t.x0;
-    GeometryCounter geometry;
+    GeometryCounter geometry;  // on the stack: its lanes are one aligned vector register
     for (int y = t.y0; y < t.y1; ++y) {
       float* values = denoised.data() + size_t(y - t.y0) * count;
       const float* depth = frame.depth_plane() + frame.index(t.x0, y);
@@ -558,15 +563,16 @@ void Job::run() {
                       y - dy);
       }
     }
-    geometry.add_to(stats.geometry_pixels, stats.mean_ao);  // mean_ao holds the sum until below
+    geometry.add_to(totals.geometry_pixels, totals.ao_sum);
   });
-  RunStats total{0, 0.0};
-  for (const RunStats& tile : tile_stats) {
-    total.geometry_pixels += tile.geometry_pixels;
-    total.mean_ao += tile.mean_ao;
+  Totals run{};
+  for (const Totals& tile : tile_totals) {
+    run.geometry_pixels += tile.geometry_pixels;
+    run.ao_sum += tile.ao_sum;
   }
-  total.mean_ao = total.geometry_pixels > 0 ? total.mean_ao / double(total.geometry_pixels) : 1.0;
-  last_run_ = total, has_run_ = true;
+  last_run_ = {run.geometry_pixels,
+               run.geometry_pixels > 0 ? run.ao_sum / double(run.geometry_pixels) : 1.0};
+  has_run_ = true;
   progress.report(1.0);
 }
 
