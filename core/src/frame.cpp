@@ -282,13 +282,14 @@ void Frame::downsample(const Frame& full, const FrameInputs& in, TilePool& pool,
   });
 }
 
-// Planar depth from the caller's values in place: radial ones divided by the ray length per unit
-// of planar depth, background marked. A loop without calls or branches, which the compiler
-// vectorises (NaN fails every comparison, so it is background).
 float background_limit(double background_depth, double clip_end) {
   const double limit = clip_end > 0.0 ? std::min(background_depth, clip_end) : background_depth;
   return static_cast<float>(std::min(limit, double(std::numeric_limits<float>::max())));
 }
+
+// Planar depth from the caller's values in place: radial ones divided by the ray length per unit
+// of planar depth, background marked. A loop without calls or branches, which the compiler
+// vectorises (NaN fails every comparison, so it is background).
 
 SSAO_VECTORIZE void Frame::planar_depth_row(const CameraIntrinsics& cam, float* __restrict depth,
                                             int x0, int count, float v, bool radial, float limit) {

@@ -1,6 +1,7 @@
-// A small RAII wrapper over the C API for front ends: ssao_tools::Job owns an ssao_job, and every
-// call throws ssao_tools::Error carrying ssao_last_error() when the core does not return SSAO_OK.
-// Header-only: it uses nothing but ssao/ssao.h.
+/* SPDX-License-Identifier: MIT
+ * libssao's C++ wrapper, header-only over the stable C API (ssao/ssao.h): ssao::api::Job owns an
+ * ssao_job, and every call throws ssao::api::Error, carrying the status and ssao_last_error(),
+ * when the library does not return SSAO_OK. It adds no symbol to the library's ABI. */
 #ifndef SSAO_SSAO_HPP
 #define SSAO_SSAO_HPP
 
@@ -101,14 +102,14 @@ class Job {
     return buffer;
   }
 
-  // "hemisphere, quality medium" plus any count set explicitly (", 16 samples"): what the
-  // front ends print about a run (a count left at 0 comes from the quality preset).
   // The core's automatic radius for the attached depth and the camera (ssao_job_auto_radius).
   double auto_radius() const {
     double radius = 0.0;
     check_status(ssao_job_auto_radius(job_, &radius), "automatic radius");
     return radius;
   }
+  // "hemisphere, quality medium" plus any count set explicitly (", 16 samples"): what the
+  // front ends print about a run (a count left at 0 comes from the quality preset).
   std::string settings_summary() const {
     std::string out = get_string("variant") + ", quality " + get_string("quality");
     for (const char* count : {"samples", "slices", "steps"}) {
