@@ -90,10 +90,10 @@ class Reader {
     fail(key, "must be one of " + join(choices) + ", got '" + value + "'");
   }
 
-  // A rows x columns matrix (rows == 1: a flat array of `columns` numbers). A 4x4 one must be
-  // affine when it is a transform (matrix_world); a projection's last row is checked by the
-  // library.
-  void matrix(const char* key, std::vector<double>& out, size_t rows, size_t columns) const {
+  // A rows x columns matrix (rows == 1: a flat array of `columns` numbers). An affine one (a
+  // transform) must end in the row 0 0 0 1; a projection's last row is checked by the library.
+  void matrix(const char* key, std::vector<double>& out, size_t rows, size_t columns,
+              bool affine) const {
     const auto it = root_.find(key);
     if (it == root_.end()) return;
     const std::string shape =
@@ -101,14 +101,11 @@ class Reader {
                   : "must be a " + std::to_string(rows) + "x" + std::to_string(columns) +
                         " matrix: an array of " + std::to_string(rows) + " rows of " +
                         std::to_string(columns) + " numbers";
-    const auto element = [&](const Json& array, size_t index, const std::string& name) {
-      return finite_number(array[index], name);
-    };
     out.assign(rows * columns, 0.0);
     if (rows == 1) {
       if (!it->is_array() || it->size() != columns) fail(key, shape);
       for (size_t col = 0; col < columns; ++col) {
-        out[col] = element(*it, col, std::string(key) + "[" + std::to_string(col) + "]");
+        out[col] = finite_number((*it)[col], std::string(key) + "[" + std::to_string(col) + "]");
       }
       return;
     }
@@ -117,13 +114,12 @@ class Reader {
       const Json& r = (*it)[row];
       if (!r.is_array() || r.size() != columns) fail(key, shape);
       for (size_t col = 0; col < columns; ++col) {
-        out[row * columns + col] = element(
-            r, col,
-            std::string(key) + "[" + std::to_string(row) + "][" + std::to_string(col) + "]");
+        out[row * columns + col] =
+            finite_number(r[col], std::string(key) + "[" + std::to_string(row) + "][" +
+                                      std::to_string(col) + "]");
       }
     }
-    if (std::string(key) == "matrix_world" &&
-        (out[12] != 0.0 || out[13] != 0.0 || out[14] != 0.0 || out[15] != 1.0)) {
+    if (affine && (out[12] != 0.0 || out[13] != 0.0 || out[14] != 0.0 || out[15] != 1.0)) {
       fail(key, "must be an affine transform: its last row must be [0, 0, 0, 1]");
     }
   }
@@ -159,6 +155,7 @@ struct MatrixField {
   std::vector<double> Camera::*member;
   const char* param;
   size_t rows, columns;
+  bool affine;  // a transform: last row 0 0 0 1
 };
 
 const std::vector<ChoiceField>& choice_fields() {
@@ -187,9 +184,9 @@ const std::vector<NumberField>& number_fields() {
 
 const std::vector<MatrixField>& matrix_fields() {
   static const std::vector<MatrixField> fields = {
-      {"matrix_world", &Camera::matrix_world, "camera_to_world", 4, 4},
-      {"intrinsics", &Camera::intrinsics, "intrinsics", 1, 4},
-      {"projection_matrix", &Camera::projection_matrix, "projection_matrix", 4, 4}};
+      {"matrix_world", &Camera::matrix_world, "camera_to_world", 4, 4, true},
+      {"intrinsics", &Camera::intrinsics, "intrinsics", 1, 4, false},
+      {"projection_matrix", &Camera::projection_matrix, "projection_matrix", 4, 4, false}};
   return fields;
 }
 
@@ -272,7 +269,7 @@ Camera parse_camera_json(const std::string& text, const std::string& source) {
     if (f.check == Check::not_negative) read.not_negative(f.key, camera.*f.member);
   }
   for (const MatrixField& f : matrix_fields())
-    read.matrix(f.key, camera.*f.member, f.rows, f.columns);
+    read.matrix(f.key, camera.*f.member, f.rows, f.columns, f.affine);
   camera.has_matrix_world = root.contains("matrix_world");
   require_projection_keys(read, camera);
 
