@@ -247,9 +247,9 @@ std::string usage_text(const std::vector<ssao_param_desc>& table) {
   // The library's parameters, a section per group (ssao_param_group), in the table's order.
   const auto param_section = [&](const char* group, const char* title) {
     text += std::string("\n") + title + "\n";
-    size_t index = 0;
-    text += ssao_tools::param_help(
-        table, [&](const ssao_param_desc&) { return ssao::api::param_group(index++) == group; });
+    text += ssao_tools::param_help(table, [&](const ssao_param_desc& desc) {
+      return ssao_tools::param_group_of(desc.name) == group;
+    });
   };
   param_section("ao",
                 "AO parameters (libssao's parameter table; --NAME_WITH_UNDERSCORES is written "

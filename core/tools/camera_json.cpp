@@ -10,6 +10,7 @@
 #include <utility>
 
 #include "ssao/ssao.hpp"
+#include "tools/param_flags.h"
 
 namespace ssao_tools {
 namespace {
@@ -292,15 +293,7 @@ Camera read_camera_json(const std::string& path) {
   return parse_camera_json(text.str(), path);
 }
 
-bool is_camera_param(const std::string& name) {
-  for (size_t i = 0; i < ssao_param_count(); ++i) {
-    ssao_param_desc desc;
-    if (ssao_param_info(i, &desc) == SSAO_OK && name == desc.name) {
-      return ssao::api::param_group(i) == "camera";
-    }
-  }
-  return false;
-}
+bool is_camera_param(const std::string& name) { return param_group_of(name) == "camera"; }
 
 void apply_camera(ssao_job job, const Camera& camera, const std::string& source) {
   const std::string where = "camera file '" + source + "': ";

@@ -74,6 +74,16 @@ std::vector<std::string> split(const std::string& text, char separator) {
   }
 }
 
+std::string param_group_of(const std::string& name) {
+  for (size_t i = 0; i < ssao_param_count(); ++i) {
+    ssao_param_desc desc;
+    if (ssao_param_info(i, &desc) == SSAO_OK && name == desc.name) {
+      return ssao::api::param_group(i);
+    }
+  }
+  return "";
+}
+
 std::string flag_for(const std::string& param_name) {
   std::string flag = "--" + param_name;
   std::replace(flag.begin(), flag.end(), '_', '-');

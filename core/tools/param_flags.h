@@ -37,6 +37,10 @@ struct ParamSetting {
 // "sphere_mode" -> "--sphere-mode".
 std::string flag_for(const std::string& param_name);
 
+// The library's group of the parameter called `name` (ssao_param_group: "ao", "camera", ...);
+// "" for no such parameter.
+std::string param_group_of(const std::string& name);
+
 // The parameter whose flag is `flag` ("--sphere-mode"), or nullptr.
 const ssao_param_desc* find_param(const std::string& flag,
                                   const std::vector<ssao_param_desc>& table);
