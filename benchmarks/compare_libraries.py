@@ -25,8 +25,8 @@ import time
 import numpy as np
 import OpenImageIO as oiio
 
-sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "blender_addon"))
-import ssao_native  # noqa: E402
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "core", "python"))
+import ssao  # noqa: E402
 
 
 def read_passes(path):
@@ -80,14 +80,14 @@ def parse_sets(items):
 
 class Runner:
     def __init__(self, path, params, depth, normal, layers):
-        self.lib = ssao_native.load_library(path)
+        self.lib = ssao.load_library(path)
         self.ao = np.zeros(depth.shape, np.float32)
-        self.job = ssao_native.Job(self.lib)
-        types = {p["name"]: p["type"] for p in ssao_native.parameters(self.lib)}
+        self.job = ssao.Job(self.lib)
+        types = {p["name"]: p["type"] for p in ssao.parameters(self.lib)}
         for name, value in params.items():
-            if types.get(name) == ssao_native.PARAM_INT:
+            if types.get(name) == ssao.PARAM_INT:
                 value = int(value)
-            elif types.get(name) == ssao_native.PARAM_FLOAT:
+            elif types.get(name) == ssao.PARAM_FLOAT:
                 value = float(value)
             self.job.set(name, value)
         self.job.set_image("depth", depth)

@@ -25,13 +25,13 @@ import time
 import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "blender_addon"))
-import ssao_native  # noqa: E402
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "core", "python"))
+import ssao  # noqa: E402
 from compare_libraries import camera_parameters, read_passes  # noqa: E402
 
 
 def make_job(lib, params, depth, normal):
-    job = ssao_native.Job(lib)
+    job = ssao.Job(lib)
     for name, value in params.items():
         job.set(name, value)
     ao = np.zeros(depth.shape, np.float32)
@@ -68,7 +68,7 @@ def sky_ratio(lib, params, depth, normal, sky, repeat):
 
 def memory_peak(lib_path, params, depth, normal):
     """Runs in a child process so that nothing else has raised its peak."""
-    lib = ssao_native.load_library(lib_path)
+    lib = ssao.load_library(lib_path)
     big_depth = np.ascontiguousarray(np.repeat(np.repeat(depth, 2, 0), 2, 1))
     big_normal = np.ascontiguousarray(np.repeat(np.repeat(normal, 2, 0), 2, 1))
     small, _ = make_job(lib, params, depth[:64, :64].copy(), normal[:64, :64].copy())
@@ -107,7 +107,7 @@ def main():
     if args.memory_child:
         memory_peak(args.library, params, depth, normal)
         return 0
-    sky_ratio(ssao_native.load_library(args.library), params, depth, normal, args.sky, args.repeat)
+    sky_ratio(ssao.load_library(args.library), params, depth, normal, args.sky, args.repeat)
     child = subprocess.run([sys.executable, os.path.abspath(__file__), "--memory-child",
                             *sys.argv[1:]], check=False)
     return child.returncode

@@ -19,8 +19,8 @@ import time
 import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "blender_addon"))
-import ssao_native  # noqa: E402
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "core", "python"))
+import ssao  # noqa: E402
 from compare_libraries import camera_parameters, read_passes  # noqa: E402
 
 
@@ -34,7 +34,7 @@ def main():
     parser.add_argument("--threads", type=int, default=2)
     parser.add_argument("--repeat", type=int, default=9)
     args = parser.parse_args()
-    lib = ssao_native.load_library(args.library)
+    lib = ssao.load_library(args.library)
     depth, normal = read_passes(args.scene)
     height, width = depth.shape
     band = args.band
@@ -47,7 +47,7 @@ def main():
     params.update(radius=args.radius, threads=args.threads)
 
     def job_for(depth_image, normal_image):
-        job = ssao_native.Job(lib)
+        job = ssao.Job(lib)
         for name, value in params.items():
             job.set(name, value)
         job.set_image("depth", depth_image)

@@ -22,8 +22,8 @@ import numpy as np
 import OpenImageIO as oiio
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "blender_addon"))
-import ssao_native  # noqa: E402
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "core", "python"))
+import ssao  # noqa: E402
 from compare_libraries import camera_parameters, read_passes  # noqa: E402
 
 BACKGROUND = 1e9  # Cycles writes 1e10 on the sky
@@ -43,10 +43,10 @@ def read_beauty(path):
 
 
 def composite(library, params, depth, normal, beauty):
-    lib = ssao_native.load_library(library)
+    lib = ssao.load_library(library)
     out = np.zeros_like(beauty)
     ao = np.zeros(depth.shape, np.float32)
-    with ssao_native.Job(lib) as job:
+    with ssao.Job(lib) as job:
         for name, value in params.items():
             job.set(name, value)
         job.set_image("depth", depth)

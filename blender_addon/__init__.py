@@ -6,10 +6,11 @@ the same zip as an extension (blender_manifest.toml). All imports are relative. 
 and in the manifest is the project's (CMakeLists.txt), written in when the zip is packaged.
 
 Modules: node (the node type), inner_tree (its built-in inner nodes), compute (libssao),
-ssao_native (the ctypes binding), recomposite (running the compositor again), multilayer (EXR
-layers), saved_form (how a .blend carries the node), handlers (render and file events),
-main_thread (render-thread handlers' work done on the main thread), operators, preferences,
-camera, compat (every Blender-version difference)."""
+ssao (the Python module core/python/ssao, the one ctypes binding; a link in the source tree, a
+copy in the zip), recomposite (running the compositor again), multilayer (EXR layers),
+saved_form (how a .blend carries the node), handlers (render and file events), main_thread
+(render-thread handlers' work done on the main thread), operators, preferences, camera, compat
+(every Blender-version difference)."""
 
 bl_info = {
     "name": "Ambient Occlusion (SSAO) compositor node",

@@ -9,7 +9,7 @@ import bpy
 import numpy as np
 
 from . import camera as camera_module
-from . import compat, hidden_surfaces, inner_tree, ssao_native
+from . import compat, hidden_surfaces, inner_tree, ssao
 
 # Where exporters write (per process; $SSAO_COMPOSITOR_EXPORT_DIR or the add-on's preference
 # override it, e.g. to keep the passes for the command-line tool). Saved files carry
@@ -35,7 +35,7 @@ def node_parameter_names():
     global _node_parameter_names
     if _node_parameter_names is None:
         try:
-            table = ssao_native.parameters(library())
+            table = ssao.parameters(library())
         except Exception:  # no library: the node shows its error, a .blend still saves
             return ()
         _node_parameter_names = tuple(p["name"] for p in table if p["group"] in NODE_GROUPS)
@@ -60,16 +60,12 @@ NORMAL_PLAUSIBLE_MIN = 0.75
 NORMAL_CHECK_SAMPLES = 4096  # pixels on a grid: a few ms at any size
 NORMAL_CHECK_MIN_PIXELS = 64  # fewer smooth surface pixels than this: nothing to judge by
 
-_library = None
 preferred_export_dir = ""  # set by preferences.py
 
 
 def library():
-    """The bundled libssao (lib/ beside this file), loaded once."""
-    global _library
-    if _library is None:
-        _library = ssao_native.load_library()
-    return _library
+    """The bundled libssao (the zip's lib/, beside the ssao module), loaded once."""
+    return ssao.library()
 
 
 def report(message, error=False):
@@ -257,7 +253,7 @@ _defaults = {}
 def library_default(name):
     """A float parameter's default, from the library's table (never repeated here)."""
     if name not in _defaults:
-        _defaults.update({p["name"]: p["default"] for p in ssao_native.parameters(library())})
+        _defaults.update({p["name"]: p["default"] for p in ssao.parameters(library())})
     return _defaults[name]
 
 
@@ -294,7 +290,7 @@ def compute_node(node, scene, passes):
     rgba = np.empty((height, width, 4), np.float32)
     # Blender's rows run bottom-up, the library's top-down: flipped views read in place.
     images, overscan = library_inputs(node, scene, passes, use_normals)
-    with ssao_native.Job(lib) as job:
+    with ssao.Job(lib) as job:
         for name, value in camera.items():
             job.set(name, value)
         job.set("background_depth", background)  # the same as the Normal check's

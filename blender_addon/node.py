@@ -3,7 +3,7 @@
 whose properties are libssao's parameters, with the library's names, defaults and ranges."""
 import bpy
 
-from . import compat, compute, handlers, inner_tree, recomposite, ssao_native
+from . import compat, compute, handlers, inner_tree, recomposite, ssao
 
 # Why the library's parameter table could not be read (shown on the node), or None.
 LIBRARY_ERROR = None
@@ -24,12 +24,12 @@ def _property_for(desc):
     """A bpy property with the library's default, range, unit and description."""
     title = desc["name"].replace("_", " ").capitalize()
     text = desc["description"] + (f" ({desc['unit']})" if desc["unit"] else "")
-    if desc["type"] == ssao_native.PARAM_STRING:
+    if desc["type"] == ssao.PARAM_STRING:
         items = [(c, c.replace("_", " ").capitalize(), "") for c in desc["choices"]]
         return bpy.props.EnumProperty(name=title, description=text, items=items,
                                       default=desc["default_string"],
                                       update=_on_parameter_changed)
-    if desc["type"] == ssao_native.PARAM_INT:
+    if desc["type"] == ssao.PARAM_INT:
         return bpy.props.IntProperty(name=title, description=text, default=int(desc["default"]),
                                      min=int(desc["min"]), max=int(desc["max"]),
                                      update=_on_parameter_changed)
@@ -44,9 +44,9 @@ def _property_for(desc):
 def _parameter_table():
     global LIBRARY_ERROR
     try:
-        table = {p["name"]: p for p in ssao_native.parameters(compute.library())}
+        table = {p["name"]: p for p in ssao.parameters(compute.library())}
         VARIANT_PARAMETERS.update({v["name"]: set(v["parameters"])
-                                   for v in ssao_native.variants(compute.library())})
+                                   for v in ssao.variants(compute.library())})
     except Exception as error:  # the node must still register so .blend files open
         LIBRARY_ERROR = str(error)
         return {}

@@ -11,8 +11,8 @@ import argparse
 import os
 import sys
 
-sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "blender_addon"))
-import ssao_native  # noqa: E402
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "core", "python"))
+import ssao  # noqa: E402
 
 HEADER = """# Parameters
 
@@ -64,8 +64,8 @@ the resolution: the same shot at another size gets the same radius. What it give
 example scenes is in [povray.md](povray.md#the-default-radius).
 """
 
-TYPES = {ssao_native.PARAM_INT: "int", ssao_native.PARAM_FLOAT: "float",
-         ssao_native.PARAM_STRING: "choice", ssao_native.PARAM_FLOATS: "floats"}
+TYPES = {ssao.PARAM_INT: "int", ssao.PARAM_FLOAT: "float",
+         ssao.PARAM_STRING: "choice", ssao.PARAM_FLOATS: "floats"}
 
 
 def number(value):
@@ -76,7 +76,7 @@ def number(value):
 
 def render_variants(lib):
     """The variants (ssao_variant_info) and the parameters only each of them reads."""
-    variants = ssao_native.variants(lib)
+    variants = ssao.variants(lib)
     lines = ["## Variants", "",
              "The `variant` parameter's choices (`ssao_variant_info()`). A count left at 0 "
              "(`samples`, `slices`, `steps`) takes the `quality` preset's value for the variant.",
@@ -89,10 +89,10 @@ def render_variants(lib):
 
 def render(lib):
     rows = []
-    for p in ssao_native.parameters(lib):
-        if p["type"] == ssao_native.PARAM_STRING:
+    for p in ssao.parameters(lib):
+        if p["type"] == ssao.PARAM_STRING:
             default, span = f"`{p['default_string']}`", " \\| ".join(f"`{c}`" for c in p["choices"])
-        elif p["type"] == ssao_native.PARAM_FLOATS:
+        elif p["type"] == ssao.PARAM_FLOATS:
             default = "identity" if p["count"] == 16 else "unset (zeros)"
             span = f"{p['count']} values"
         else:
@@ -108,7 +108,7 @@ def main():
     parser.add_argument("--library", default=None)
     parser.add_argument("--check", default=None, help="compare with this file instead of printing")
     args = parser.parse_args()
-    text = render(ssao_native.load_library(args.library))
+    text = render(ssao.load_library(args.library))
     if args.check:
         with open(args.check) as f:
             if f.read() != text:

@@ -18,7 +18,7 @@ import numpy as np
 
 addon = {name.rsplit(".", 1)[-1]: module for name, module in sys.modules.items()
          if name.split(".")[-2:-1] == ["ssao_compositor"]}
-native = addon["ssao_native"]
+native = addon["ssao"]
 scene = bpy.context.scene
 tree = addon["compat"].compositor_tree(scene)
 node = next(n for n in tree.nodes if n.bl_idname == "CompositorNodeSSAO")

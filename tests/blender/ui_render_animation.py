@@ -50,7 +50,7 @@ def break_frame(frame):
     """An AO of 0.5 in every SSAO node, and a library that fails on `frame` (the AO is
     computed on the main thread, after the render job, with the scene set to the frame)."""
     compute, inner_tree, native = (addon_module(n) for n in ("compute", "inner_tree",
-                                                             "ssao_native"))
+                                                             "ssao"))
     scene = bpy.context.scene
     width, height = scene.render.resolution_x, scene.render.resolution_y
     for node in compute.ssao_nodes(scene):

@@ -1,6 +1,6 @@
 #!/usr/bin/python3
 # SPDX-License-Identifier: MIT
-"""The ctypes binding (blender_addon/ssao_native.py) against the built library, without Blender.
+"""The ctypes binding (core/python/ssao/_binding.py) against the built library, without Blender.
 
     /usr/bin/python3 tests/python/test_native.py LIBRARY
 """
@@ -11,8 +11,8 @@ import unittest
 import numpy as np
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..",
-                                "blender_addon"))
-import ssao_native  # noqa: E402
+                                "core", "python"))
+import ssao  # noqa: E402
 
 LIBRARY = None
 
@@ -27,11 +27,11 @@ def corner_scene(width=64, height=48):
 class NativeBindingTest(unittest.TestCase):
     @classmethod
     def setUpClass(cls):
-        cls.lib = ssao_native.load_library(LIBRARY)
+        cls.lib = ssao.load_library(LIBRARY)
 
     def run_ao(self, depth, **params):
         ao = np.full(depth.shape, -1.0, np.float32)
-        with ssao_native.Job(self.lib) as job:
+        with ssao.Job(self.lib) as job:
             job.set("lens", 35.0)
             for key, value in params.items():
                 job.set(key, value)
@@ -41,20 +41,20 @@ class NativeBindingTest(unittest.TestCase):
         return ao
 
     def test_parameter_table_has_the_documented_defaults(self):
-        params = {p["name"]: p for p in ssao_native.parameters(self.lib)}
+        params = {p["name"]: p for p in ssao.parameters(self.lib)}
         self.assertEqual(params["variant"]["default_string"], "hemisphere")
         self.assertEqual(params["radius"]["unit"], "scene units")
         self.assertEqual(params["camera_to_world"]["count"], 16)
 
     def test_errors_raise_with_the_library_message(self):
-        with ssao_native.Job(self.lib) as job:
-            with self.assertRaisesRegex(ssao_native.SSAOError, "unknown parameter 'radus'"):
+        with ssao.Job(self.lib) as job:
+            with self.assertRaisesRegex(ssao.SSAOError, "unknown parameter 'radus'"):
                 job.set("radus", 1.0)
-            with self.assertRaisesRegex(ssao_native.SSAOError, "must be in"):
+            with self.assertRaisesRegex(ssao.SSAOError, "must be in"):
                 job.set("radius", -2.0)
-            with self.assertRaisesRegex(ssao_native.SSAOError, "no depth image"):
+            with self.assertRaisesRegex(ssao.SSAOError, "no depth image"):
                 job.run()
-            with self.assertRaisesRegex(ssao_native.SSAOError, "float32"):
+            with self.assertRaisesRegex(ssao.SSAOError, "float32"):
                 job.set_image("depth", np.zeros((4, 4), np.float64))
 
     def test_last_run_counts_geometry_and_its_mean_ao(self):
@@ -63,12 +63,12 @@ class NativeBindingTest(unittest.TestCase):
         depth[5, 30] = np.nan       # hostile values are background too
         depth[6, 30] = -1.0
         ao = np.full(depth.shape, -1.0, np.float32)
-        with ssao_native.Job(self.lib) as job:
+        with ssao.Job(self.lib) as job:
             job.set("lens", 35.0)
             job.set("radius", 1.0)
             job.set_image("depth", depth)
             job.set_image("ao", ao)
-            with self.assertRaisesRegex(ssao_native.SSAOError, "no successful run"):
+            with self.assertRaisesRegex(ssao.SSAOError, "no successful run"):
                 job.last_run()
             job.run()
             geometry, mean = job.last_run()
@@ -97,13 +97,13 @@ class NativeBindingTest(unittest.TestCase):
         depth = corner_scene()
         seen = []
         ao = np.zeros_like(depth)
-        with ssao_native.Job(self.lib) as job:
+        with ssao.Job(self.lib) as job:
             job.set_image("depth", depth)
             job.set_image("ao", ao)
             job.run(progress=lambda f: seen.append(f) is None)
             self.assertEqual(seen[-1], 1.0)
             self.assertEqual(seen, sorted(seen))
-            with self.assertRaisesRegex(ssao_native.SSAOError, "cancelled"):
+            with self.assertRaisesRegex(ssao.SSAOError, "cancelled"):
                 job.run(progress=lambda f: False)
 
     def test_output_window_takes_the_frame_out_of_a_larger_depth(self):
@@ -112,7 +112,7 @@ class NativeBindingTest(unittest.TestCase):
         depth = corner_scene()
         whole = self.run_ao(depth, radius=1.0)
         frame = np.zeros((48 - 2 * 8, 64 - 2 * 8), np.float32)
-        with ssao_native.Job(self.lib) as job:
+        with ssao.Job(self.lib) as job:
             job.set("radius", 1.0)
             job.set("lens", 35.0)
             job.set("sensor_width", 36.0 * 48 / 64)  # the frame is 48 of the 64 px wide
@@ -122,7 +122,7 @@ class NativeBindingTest(unittest.TestCase):
             job.run()
             np.testing.assert_array_equal(frame, whole[8:40, 8:56])
             job.set_output_window(17, 8)
-            with self.assertRaisesRegex(ssao_native.SSAOError, "does not fit in the 64x48"):
+            with self.assertRaisesRegex(ssao.SSAOError, "does not fit in the 64x48"):
                 job.run()
 
 

@@ -1,17 +1,22 @@
 # SPDX-License-Identifier: MIT
-"""ctypes binding to libssao's C API (core/include/ssao/ssao.h).
+"""The ctypes binding to libssao's C API (core/include/ssao/ssao.h): the one binding, used by the
+`ssao` module's ambient_occlusion() and by the Blender add-on (which bundles this package).
 
-No bpy import: usable from plain Python (tests, scripts) and from Blender alike. Images are
-numpy float32 arrays of shape (height, width) or (height, width, channels), row 0 on top; any
-strides are passed through, so views into larger arrays are read in place.
+ctypes rather than a compiled extension: one file serves every Python a user runs it from
+(Debian's python3, and Blender 3.4's, 4.3's and 5.2's own), with no build per Python version.
+No bpy import. Images are numpy float32 arrays of shape (height, width) or (height, width,
+channels), row 0 on top; their strides are passed through, so views into larger arrays (and
+flipped ones) are read in place.
 """
 import ctypes
+import numbers
 import os
 import sys
 
 ABI_MAJOR = 0
 
 _LIB_NAMES = {"linux": "libssao.so", "darwin": "libssao.dylib", "win32": "ssao.dll"}
+_SONAME = "libssao.so.%d" % ABI_MAJOR  # what a package without the -dev symlink installs
 
 
 class SSAOError(RuntimeError):
@@ -46,30 +51,58 @@ _PROGRESS_FN = ctypes.CFUNCTYPE(ctypes.c_int, ctypes.c_void_p, ctypes.c_double)
 
 
 def _candidate_paths(path):
+    """Where libssao may be, in order: the caller's path, $SSAO_LIBRARY, a lib/ folder beside this
+    package (how the Blender add-on bundles it), where `cmake --install` put it (_installed.py,
+    written at install time), the source tree's
+    build/lib/ (this file is core/python/ssao/ there); and last the system's loader by SONAME
+    (a library in a standard folder or on LD_LIBRARY_PATH)."""
     if path:
         yield path
     if os.environ.get("SSAO_LIBRARY"):
         yield os.environ["SSAO_LIBRARY"]
     here = os.path.dirname(os.path.abspath(__file__))
     name = _LIB_NAMES.get(sys.platform, "libssao.so")
-    yield os.path.join(here, "lib", name)
-    yield os.path.join(here, "..", "build", "lib", name)
+    yield os.path.normpath(os.path.join(here, "..", "lib", name))  # bundled: the Blender add-on
+    try:
+        from . import _installed
+        yield os.path.normpath(os.path.join(here, _installed.LIBRARY))
+    except ImportError:  # not installed: the source tree (also through blender_addon/ssao, a link)
+        source = os.path.dirname(os.path.realpath(__file__))
+        yield os.path.normpath(os.path.join(source, "..", "..", "..", "build", "lib", name))
+    yield _SONAME
+
+
+_default_library = None
+
+
+def library():
+    """The library of load_library(), loaded on first use and kept."""
+    global _default_library
+    if _default_library is None:
+        _default_library = load_library()
+    return _default_library
 
 
 def load_library(path=None):
-    """Loads libssao (explicit path, $SSAO_LIBRARY, the add-on's lib/, or build/lib/)."""
+    """Loads libssao from the first of _candidate_paths() that exists; SSAOError, listing where
+    it looked, when none does or the library's major version is not this binding's."""
     errors = []
     for candidate in _candidate_paths(path):
-        if not os.path.exists(candidate):
+        if os.sep in candidate and not os.path.exists(candidate):
             errors.append(f"{candidate}: not found")
             continue
-        lib = ctypes.CDLL(candidate)
+        try:
+            lib = ctypes.CDLL(candidate)
+        except OSError as error:
+            errors.append(str(error))
+            continue
         _declare(lib)
         version = lib.ssao_version()
         if version // 10000 != ABI_MAJOR:
             raise SSAOError(f"{candidate} is libssao {version}, this binding needs {ABI_MAJOR}.x")
         return lib
-    raise SSAOError("libssao not found: " + "; ".join(errors))
+    raise SSAOError("libssao not found: " + "; ".join(errors) +
+                    " (set SSAO_LIBRARY to the library's path)")
 
 
 def _declare(lib):
@@ -109,10 +142,45 @@ def _declare(lib):
     if hasattr(lib, "ssao_job_set_output_window"):  # since 0.1 after 7bf6fcd (overscan)
         sig("ssao_job_set_output_window", c_int, job, c_int, c_int, c_int)
     sig("ssao_job_set_progress", c_int, job, _PROGRESS_FN, ctypes.c_void_p)
+    sig("ssao_job_auto_radius", c_int, job, ctypes.POINTER(c_double))
     sig("ssao_job_run", c_int, job)
     if hasattr(lib, "ssao_job_last_run"):  # since 0.1 after issue 23
         sig("ssao_job_last_run", c_int, job, ctypes.POINTER(ctypes.c_size_t),
             ctypes.POINTER(c_double))
+
+
+OUTPUT_IMAGES = ("ao", "composite")
+
+
+def image_layout_error(array, writable=False):
+    """Why the library cannot use `array` as an image in place (None if it can). It reads
+    rows of pixels of adjacent float32 channels: any row step (negative too: a flipped view) and
+    any pixel step of at least one pixel, e.g. array[::2, ::2]; not a transposed or Fortran-order
+    array, columns reversed, a broadcast (stride 0) or unaligned data."""
+    import numpy as np
+    if not isinstance(array, np.ndarray):
+        return f"must be a numpy array, got {type(array).__name__}"
+    if array.dtype != np.float32:
+        return f"must be float32 (native byte order), got {array.dtype}; use .astype(np.float32)"
+    if array.ndim not in (2, 3):
+        return f"must have 2 dimensions (height, width) or 3 (height, width, channels), " \
+               f"got shape {array.shape}"
+    height, width = array.shape[:2]
+    channels = array.shape[2] if array.ndim == 3 else 1
+    pixel = 4 * channels
+    fix = "; pass np.ascontiguousarray(array)"
+    if array.ndim == 3 and channels > 1 and array.strides[2] != 4:
+        return f"its channels are not adjacent floats (strides {array.strides}){fix}"
+    if width > 1 and array.strides[1] < pixel:
+        return f"its pixels are not in rows of increasing address (strides {array.strides}: " \
+               f"transposed, reversed or broadcast){fix}"
+    if height > 1 and abs(array.strides[0]) < (array.strides[1] if width > 1 else pixel) * width:
+        return f"its rows overlap (strides {array.strides}: transposed or broadcast){fix}"
+    if not array.flags.aligned or any(step % 4 for step in array.strides):
+        return f"its data is not aligned to 4 bytes{fix}"
+    if writable and not array.flags.writeable:
+        return "is read-only, and the library writes it"
+    return None
 
 
 def parameters(lib):
@@ -149,11 +217,25 @@ def variants(lib):
     return out
 
 
+def _int_value(name, value):
+    if isinstance(value, bool) or not isinstance(value, numbers.Integral):
+        raise SSAOError(f"parameter '{name}' must be an int, got {type(value).__name__}")
+    if not -2**31 <= value < 2**31:
+        raise SSAOError(f"parameter '{name}' is out of range: {value}")
+    return int(value)
+
+
+def _float_value(name, value):
+    if isinstance(value, bool) or not isinstance(value, numbers.Real):
+        raise SSAOError(f"parameter '{name}' must be a number, got {type(value).__name__}")
+    return float(value)  # NaN and infinity reach the library, which says what it accepts
+
+
 class Job:
     """One AO job. Use as a context manager or call close()."""
 
     def __init__(self, lib=None):
-        self._lib = lib or load_library()
+        self._lib = lib or library()
         handle = ctypes.c_void_p()
         self._lib.ssao_job_create(ctypes.byref(handle))
         self._job = handle
@@ -172,44 +254,68 @@ class Job:
         self.close()
 
     def set(self, name, value):
-        """Sets a parameter; the type comes from the library's table."""
+        """Sets a parameter; the type comes from the library's table. SSAOError for a value of
+        another type (a str for a number, a float for an int, ...): never converted."""
         kind = self._types.get(name)
         key = name.encode()
         if kind == PARAM_INT:
-            self._lib.ssao_job_set_int(self._job, key, int(value))
+            self._lib.ssao_job_set_int(self._job, key, _int_value(name, value))
         elif kind == PARAM_FLOAT:
-            self._lib.ssao_job_set_float(self._job, key, float(value))
+            self._lib.ssao_job_set_float(self._job, key, _float_value(name, value))
         elif kind == PARAM_STRING:
-            self._lib.ssao_job_set_string(self._job, key, str(value).encode())
+            if not isinstance(value, str):
+                raise SSAOError(f"parameter '{name}' must be a str, got {type(value).__name__}")
+            self._lib.ssao_job_set_string(self._job, key, value.encode())
         elif kind == PARAM_FLOATS:
-            values = [float(v) for v in value]
+            if isinstance(value, (str, bytes)) or not hasattr(value, "__len__"):
+                raise SSAOError(f"parameter '{name}' must be a sequence of numbers, got "
+                                f"{type(value).__name__}")
+            values = [_float_value(name, v) for v in value]
             array = (ctypes.c_double * len(values))(*values)
             self._lib.ssao_job_set_floats(self._job, key, array, len(values))
         else:
             # Let the library produce its "unknown parameter" message.
             self._lib.ssao_job_set_float(self._job, key, float("nan"))
 
+    def get(self, name):
+        """A parameter's value (int, float, str or a list of floats), by the library's table."""
+        kind, key = self._types.get(name), name.encode()
+        if kind == PARAM_INT:
+            value = ctypes.c_int()
+            self._lib.ssao_job_get_int(self._job, key, ctypes.byref(value))
+            return value.value
+        if kind == PARAM_STRING:
+            text = ctypes.create_string_buffer(256)
+            self._lib.ssao_job_get_string(self._job, key, text, len(text))
+            return text.value.decode()
+        value = ctypes.c_double()  # floats; an unknown name gets the library's message
+        self._lib.ssao_job_get_float(self._job, key, ctypes.byref(value))
+        return value.value
+
+    def auto_radius(self):
+        """The library's automatic radius for the attached depth and camera (ssao_job_auto_radius);
+        SSAOError when the depth has no geometry pixel."""
+        radius = ctypes.c_double()
+        self._lib.ssao_job_auto_radius(self._job, ctypes.byref(radius))
+        return radius.value
+
     def set_image(self, name, array):
-        """Attaches a float32 numpy array (H, W) or (H, W, C); None detaches."""
+        """Attaches a float32 numpy array (H, W) or (H, W, C), read (or, for the outputs "ao" and
+        "composite", written) in place; None detaches. SSAOError for an array the library cannot
+        address in place: see image_layout_error()."""
         if array is None:
             self._lib.ssao_job_set_image(self._job, name.encode(), None, 0, 0, 1, 0, 0)
             self._images.pop(name, None)
             return
-        import numpy as np
-        if array.dtype != np.float32:
-            raise SSAOError(f"image '{name}' must be float32, got {array.dtype}")
-        if array.ndim == 2:
-            height, width = array.shape
-            channels, pixel_stride = 1, array.strides[1]
-        elif array.ndim == 3:
-            height, width, channels = array.shape
-            pixel_stride = array.strides[1]
-            if array.strides[2] != 4:
-                raise SSAOError(f"image '{name}': channels must be adjacent floats")
-        else:
-            raise SSAOError(f"image '{name}' must have 2 or 3 dimensions")
+        problem = image_layout_error(array, writable=name in OUTPUT_IMAGES)
+        if problem:
+            raise SSAOError(f"image '{name}': {problem}")
+        height, width = array.shape[:2]
+        channels = array.shape[2] if array.ndim == 3 else 1
+        pixel_stride = array.strides[1] if width > 1 else 4 * channels
+        row_stride = array.strides[0] if height > 1 else pixel_stride * width
         self._lib.ssao_job_set_image(self._job, name.encode(), array.ctypes.data, width, height,
-                                     channels, pixel_stride, array.strides[0])
+                                     channels, pixel_stride, row_stride)
         self._images[name] = array
 
     def set_output_window(self, x, y, enable=True):

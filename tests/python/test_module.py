@@ -1,0 +1,276 @@
+#!/usr/bin/python3
+# SPDX-License-Identifier: MIT
+"""The Python module `ssao` (core/python/ssao) against the command-line tool on the bundled
+sample, and its answers to bad input, from Debian's python3 with numpy and OpenImageIO.
+
+    /usr/bin/python3 tests/python/test_module.py SSAO_CLI [MODULE_FOLDER]
+
+MODULE_FOLDER (default: core/python of this checkout) is put first on sys.path, so the same
+test runs on an installed module (tests/install/test_install.sh passes PREFIX's).
+"""
+import json
+import os
+import subprocess
+import sys
+import tempfile
+import unittest
+import warnings
+
+import numpy as np
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path.insert(0, os.path.join(HERE, ".."))
+from image_files import read_image  # noqa: E402
+
+CLI = sys.argv[1] if len(sys.argv) > 1 else ""
+MODULE_FOLDER = sys.argv[2] if len(sys.argv) > 2 else os.path.join(HERE, "..", "..", "core",
+                                                                    "python")
+del sys.argv[1:]
+sys.path.insert(0, MODULE_FOLDER)
+import ssao  # noqa: E402
+
+SAMPLE = os.path.join(HERE, "..", "data", "sample")
+
+
+def load_sample():
+    names, pixels = read_image(SAMPLE + ".exr")
+    index = {name: k for k, name in enumerate(names)}
+    depth = pixels[:, :, index["ViewLayer.Depth.Z"]]  # a view: read in place, strided
+    k = index["ViewLayer.Normal.X"]
+    normals = pixels[:, :, k:k + 3]
+    k = index["ViewLayer.Combined.R"]
+    beauty = pixels[:, :, k:k + 4]
+    with open(SAMPLE + ".camera.json") as f:
+        camera = json.load(f)
+    return depth, normals, beauty, camera
+
+
+def run_cli(*args, camera=None):
+    """The CLI's output file's channels {name: (H, W)} for the sample (and its camera, or
+    `camera` written to a file)."""
+    with tempfile.TemporaryDirectory() as folder:
+        camera_path = SAMPLE + ".camera.json"
+        if camera is not None:
+            camera_path = os.path.join(folder, "camera.json")
+            with open(camera_path, "w") as f:
+                json.dump(camera, f)
+        out = os.path.join(folder, "out.exr")
+        subprocess.run([CLI, SAMPLE + ".exr", "--camera", camera_path, "-o", out, "--quiet",
+                        *args], check=True)
+        names, pixels = read_image(out)
+    return {name: pixels[:, :, k] for k, name in enumerate(names)}
+
+
+class AgainstCli(unittest.TestCase):
+    """Same inputs, same AO: the bits of the CLI's output."""
+
+    @classmethod
+    def setUpClass(cls):
+        cls.depth, cls.normals, cls.beauty, cls.camera = load_sample()
+
+    def assert_same_bits(self, a, b):
+        self.assertEqual(a.shape, b.shape)
+        differ = np.count_nonzero(a.view(np.uint32) != b.view(np.uint32))
+        self.assertEqual(differ, 0, f"{differ} pixels differ, max "
+                                    f"{np.max(np.abs(a - b)) if differ else 0}")
+
+    def test_radius_and_normal_pass(self):
+        ao = ssao.ambient_occlusion(self.depth, normals=self.normals, camera=self.camera,
+                                    radius=0.8)
+        self.assertEqual((ao.dtype, ao.shape), (np.float32, self.depth.shape))
+        self.assertGreater(np.count_nonzero(ao < 0.9), 100)  # there is AO to compare
+        self.assert_same_bits(ao, run_cli("--radius", "0.8", "--ao-only")["AO"])
+
+    def test_automatic_radius_variant_and_no_normals(self):
+        ao = ssao.ambient_occlusion(self.depth, camera=self.camera, variant="horizon",
+                                    samples=12)
+        cli = run_cli("--no-normals", "--variant", "horizon", "--samples", "12", "--ao-only")
+        self.assert_same_bits(ao, cli["AO"])
+
+    def test_ao_distance_is_the_default_radius(self):
+        camera = dict(self.camera, ao_distance=0.5)
+        ao = ssao.ambient_occlusion(self.depth, normals=self.normals, camera=camera)
+        self.assert_same_bits(ao, run_cli("--ao-only", camera=camera)["AO"])
+        self.assert_same_bits(ao, ssao.ambient_occlusion(self.depth, normals=self.normals,
+                                                         camera=self.camera, radius=0.5))
+
+    def test_composite(self):
+        ao, composite = ssao.ambient_occlusion(self.depth, normals=self.normals,
+                                               camera=self.camera, radius=0.8,
+                                               beauty=self.beauty)
+        cli = run_cli("--radius", "0.8")
+        self.assert_same_bits(ao, cli["AO"])
+        for c, name in enumerate("RGBA"):
+            self.assert_same_bits(np.ascontiguousarray(composite[:, :, c]), cli[name])
+
+    def test_docs_example(self):
+        # docs/examples/ambient_occlusion.py, as docs/python.md runs it.
+        example = os.path.join(HERE, "..", "..", "docs", "examples", "ambient_occlusion.py")
+        with tempfile.TemporaryDirectory() as folder:
+            out = os.path.join(folder, "ao.exr")
+            env = dict(os.environ, PYTHONPATH=os.path.abspath(MODULE_FOLDER))
+            subprocess.run([sys.executable, example, SAMPLE + ".exr", SAMPLE + ".camera.json",
+                            out, "0.8"], check=True, env=env, stdout=subprocess.DEVNULL)
+            names, pixels = read_image(out)
+        self.assertEqual(names, ["AO"])
+        self.assert_same_bits(pixels[:, :, 0], run_cli("--radius", "0.8", "--ao-only")["AO"])
+
+    def test_input_layout_does_not_change_the_bits(self):
+        contiguous = ssao.ambient_occlusion(np.ascontiguousarray(self.depth),
+                                            normals=np.ascontiguousarray(self.normals),
+                                            camera=self.camera, radius=0.8)
+        flipped_twice = self.depth[::-1][::-1]  # a view with a negative step taken back
+        bottom_up = np.ascontiguousarray(self.depth[::-1])[::-1]  # rows stored bottom-up
+        for depth in (self.depth, flipped_twice, bottom_up):
+            ao = ssao.ambient_occlusion(depth, normals=self.normals, camera=self.camera,
+                                        radius=0.8)
+            self.assert_same_bits(ao, contiguous)
+
+
+class OtherInputs(unittest.TestCase):
+    @classmethod
+    def setUpClass(cls):
+        cls.depth, cls.normals, cls.beauty, cls.camera = load_sample()
+
+    def test_output_window_is_the_widened_camera_cropped(self):
+        # With intrinsics the frame of a window at (x, y) is the whole image with the principal
+        # point moved by (x, y): the library's overscan contract, checked independently.
+        height, width = self.depth.shape
+        fx = 35.0 / 36.0 * width
+        camera = {"projection": "intrinsics", "type": "PERSP", "intrinsics":
+                  [fx, fx, width / 2, height / 2], "matrix_world": self.camera["matrix_world"]}
+        x, y, w, h = 20, 10, 180, 100
+        whole = ssao.ambient_occlusion(self.depth, normals=self.normals, camera=camera,
+                                       radius=0.8)
+        window_camera = dict(camera, intrinsics=[fx, fx, width / 2 - x, height / 2 - y])
+        window = ssao.ambient_occlusion(self.depth, normals=self.normals, camera=window_camera,
+                                        radius=0.8, output_window=(x, y, w, h))
+        self.assertEqual(window.shape, (h, w))
+        np.testing.assert_allclose(window, whole[y:y + h, x:x + w], atol=1e-6)
+
+    def test_depth_layers(self):
+        behind = self.depth * np.float32(1.02)  # a thin shell behind every surface
+        one = ssao.ambient_occlusion(self.depth, camera=self.camera, radius=0.8,
+                                     variant="hemisphere")
+        two = ssao.ambient_occlusion(self.depth, camera=self.camera, radius=0.8,
+                                     variant="hemisphere", depth_layers=[behind])
+        self.assertGreater(np.count_nonzero(one != two), 100)
+        with self.assertRaisesRegex(ssao.SSAOError, "nearer"):
+            ssao.ambient_occlusion(self.depth, camera=self.camera, radius=0.8,
+                                   variant="hemisphere", depth_layers=[self.depth * 0.5])
+
+    def test_progress_and_cancel(self):
+        seen = []
+        ssao.ambient_occlusion(self.depth, camera=self.camera, radius=0.8, progress=seen.append)
+        self.assertTrue(seen and seen[-1] == 1.0 and seen == sorted(seen), seen)
+        with self.assertRaisesRegex(ssao.SSAOError, "cancelled"):
+            ssao.ambient_occlusion(self.depth, camera=self.camera, radius=0.8,
+                                   progress=lambda fraction: False)
+
+    def test_background_pixels(self):
+        depth = np.array(self.depth)
+        depth[:10] = np.nan  # the library's contract: NaN is background, AO exactly 1
+        depth[10:20] = np.inf
+        ao = ssao.ambient_occlusion(depth, camera=self.camera, radius=0.8)
+        self.assertTrue(np.all(ao[:20] == 1.0))
+        self.assertTrue(np.all(np.isfinite(ao)))
+
+    def test_module_facts(self):
+        self.assertRegex(ssao.version(), r"^\d+\.\d+\.\d+$")
+        names = {p["name"] for p in ssao.parameters()}
+        self.assertTrue({"radius", "variant", "samples", "lens"} <= names)
+        self.assertIn("horizon", {v["name"] for v in ssao.variants()})
+
+
+class BadInput(unittest.TestCase):
+    """Every bad input is an ssao.SSAOError with a message that says what is wrong."""
+
+    @classmethod
+    def setUpClass(cls):
+        cls.depth, cls.normals, cls.beauty, cls.camera = load_sample()
+        cls.contiguous = np.ascontiguousarray(cls.depth)
+
+    def refused(self, pattern, depth=None, **kwargs):
+        kwargs.setdefault("camera", self.camera)
+        if kwargs.setdefault("radius", 0.8) is None:
+            del kwargs["radius"]  # the automatic radius
+        with self.assertRaisesRegex(ssao.SSAOError, pattern):
+            ssao.ambient_occlusion(self.contiguous if depth is None else depth, **kwargs)
+
+    def test_dtype(self):
+        self.refused(r"depth must be float32.*got float64", self.contiguous.astype(np.float64))
+        self.refused(r"depth must be float32.*got int32", np.zeros((135, 240), np.int32))
+        self.refused(r"depth must be float32.*got >f4", self.contiguous.astype(">f4"))
+        self.refused(r"normals must be float32", normals=self.normals.astype(np.float16))
+        self.refused(r"depth must be a numpy array, got list", self.contiguous.tolist())
+
+    def test_shape(self):
+        self.refused(r"must have 2 dimensions.*got shape \(32400,\)", self.contiguous.ravel())
+        self.refused(r"depth must have 1 channels", self.normals)
+        self.refused(r"normals has shape \(135, 239\), the depth \(135, 240\)",
+                     normals=self.normals[:, 1:])
+        self.refused(r"normals must have 3 or 4 channels", normals=self.normals[:, :, :2])
+        self.refused(r"depth_layers\[0\] has shape", depth_layers=[self.contiguous[1:]])
+        self.refused(r"beauty has shape", beauty=self.beauty[1:])
+        self.refused(r"output_window must be \(x, y, width, height\)", output_window=(1, 2))
+        self.refused(r"output window.*does not fit", output_window=(200, 0, 100, 100))
+
+    def test_layouts_the_library_cannot_read_in_place(self):
+        self.refused(r"depth.*transposed.*np.ascontiguousarray", self.contiguous.T.T.T)
+        self.refused(r"depth.*reversed.*np.ascontiguousarray", self.contiguous[:, ::-1])
+        self.refused(r"depth.*broadcast", np.broadcast_to(self.contiguous[:1], (135, 240)))
+        self.refused(r"normals.*channels are not adjacent",
+                     normals=np.ascontiguousarray(self.normals.transpose(2, 0, 1))
+                     .transpose(1, 2, 0))
+        raw = np.zeros(self.contiguous.nbytes + 1, np.uint8)[1:]
+        unaligned = raw.view(np.float32).reshape(self.contiguous.shape)
+        unaligned[...] = self.contiguous
+        self.refused(r"not aligned", unaligned)
+
+    def test_nan_and_out_of_range_values(self):
+        self.refused(r"'radius' must be finite, got nan", radius=float("nan"))
+        self.refused(r"threads.*must be in", threads=-3)
+        self.refused(r"'threads' is out of range", threads=2**40)
+        self.refused(r"'threads' must be an int, got float", threads=2.0)
+        self.refused(r"'radius' must be a number, got str", radius="0.8")
+        self.refused(r"camera: .*'lens' must be finite, got nan",
+                     camera=dict(self.camera, lens=float("nan")))
+        self.refused(r"camera key 'ao_distance' must be a finite number",
+                     camera=dict(self.camera, ao_distance=float("inf")), radius=None)
+        self.refused(r"camera: .*lens.*must be in", camera=dict(self.camera, lens=-35.0))
+        self.refused(r"no geometry pixel", np.full_like(self.contiguous, np.nan))
+        self.refused(r"no geometry pixel", np.full_like(self.contiguous, np.nan), radius=None)
+
+    def test_parameters_and_camera(self):
+        self.refused(r"unknown parameter 'radus'", radus=1.0)
+        self.refused(r"variant.*must be one of", variant="nope")
+        self.refused(r"missing key 'lens'", camera={k: v for k, v in self.camera.items()
+                                                    if k != "lens"})
+        self.refused(r"missing key 'ortho_scale'", camera=dict(
+            {k: v for k, v in self.camera.items() if k != "ortho_scale"}, type="ORTHO"))
+        self.refused(r"'matrix_world' must be a 4x4 matrix", camera=dict(
+            self.camera, matrix_world=[[1, 0, 0], [0, 1, 0], [0, 0, 1]]))
+        self.refused(r"'matrix_world' must be an affine transform", camera=dict(
+            self.camera, matrix_world=[[1, 0, 0, 0]] * 4))
+        self.refused(r"missing key 'matrix_world', which world-space normals need",
+                     normals=self.normals, camera={k: v for k, v in self.camera.items()
+                                                   if k != "matrix_world"})
+        self.refused(r"camera must be a dict", camera="sample.camera.json")
+        self.refused(r"camera: parameter 'shift_x' must be a number, got str",
+                     camera=dict(self.camera, shift_x="0"))
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            ssao.ambient_occlusion(self.contiguous, camera=dict(self.camera, focus=3.0),
+                                   radius=0.8)
+        self.assertIn("unknown key 'focus' ignored", str(caught[0].message))
+
+    def test_empty_images(self):
+        self.refused(r"depth must have 2 dimensions", np.zeros((0,), np.float32))
+        self.refused(r"no geometry pixel", np.zeros((0, 0), np.float32))
+        self.refused(r"no geometry pixel", np.zeros((0, 0), np.float32), radius=None)
+
+
+if __name__ == "__main__":
+    if not CLI:
+        sys.exit("usage: test_module.py SSAO_CLI [MODULE_FOLDER]")
+    unittest.main(verbosity=1)
