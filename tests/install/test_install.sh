@@ -5,7 +5,9 @@
 #   - docs/examples/minimal.c and minimal.cpp built with find_package(ssao) (ssao::ssao) and with
 #     pkg-config (ssao.pc), and run (each checks its own AO);
 #   - the installed ssao and povray-ssao: no run path into the build tree, --version, and the
-#     installed ssao on the bundled sample giving the build tree's AO bit for bit.
+#     installed ssao on the bundled sample giving the build tree's AO bit for bit;
+#   - the installed Python module ssao: it loads the prefix's library by itself and passes
+#     tests/python/test_module.py against the installed ssao.
 # Usage: test_install.sh BUILD_DIR SOURCE_DIR
 set -euo pipefail
 build=$(realpath "$1")
@@ -76,4 +78,14 @@ import OpenImageIO as oiio
 a, b = (oiio.ImageBuf(p).get_pixels(oiio.FLOAT) for p in sys.argv[1:3])
 sys.exit(0 if a.shape == b.shape and np.array_equal(a, b) and a.size > 0 else 1)
 PY
-echo "test_install: ok (prefix $prefix: find_package, pkg-config, C and C++, installed tools)"
+
+# The installed Python module: it finds the installed library by itself (no SSAO_LIBRARY, no
+# build tree on its search path), and passes the module's test against the installed ssao.
+pythondir="$prefix/lib/python3/dist-packages"
+[ -f "$pythondir/ssao/__init__.py" ] || fail "the Python module ssao is not installed in $pythondir"
+found=$(cd "$work" && env -u SSAO_LIBRARY PYTHONPATH="$pythondir" /usr/bin/python3 -c \
+  'import ssao; print(ssao.library()._name)') || fail "import ssao from the prefix"
+case "$found" in "$prefix"/*) ;; *) fail "the installed module loaded $found, not the prefix's" ;; esac
+env -u SSAO_LIBRARY /usr/bin/python3 "$source/tests/python/test_module.py" "$prefix/bin/ssao" "$pythondir" \
+  > "$work/python.log" 2>&1 || { cat "$work/python.log"; fail "the installed Python module's test"; }
+echo "test_install: ok (prefix $prefix: find_package, pkg-config, C and C++, installed tools, Python module)"
