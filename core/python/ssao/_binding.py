@@ -184,7 +184,15 @@ def image_layout_error(array, writable=False):
 
 
 def parameters(lib):
-    """Returns the library's parameter table as a list of dicts (name, type, default, ...)."""
+    """Returns the library's parameter table as a list of dicts (name, type, default, ...): a
+    copy of the table read once per loaded library (it never changes while loaded)."""
+    table = lib.__dict__.get("_ssao_parameters")
+    if table is None:
+        table = lib.__dict__["_ssao_parameters"] = _read_parameters(lib)
+    return [dict(p) for p in table]
+
+
+def _read_parameters(lib):
     out = []
     for i in range(lib.ssao_param_count()):
         d = _ParamDesc()
