@@ -15,7 +15,7 @@ PACKAGES=(
   python3-matplotlib                        # benchmark plots (scripts/benchmark.sh)
   blender                                   # ground truth renders (Cycles AO pass)
   povray povray-examples                    # the POV-Ray bridge and its test scenes
-  debootstrap                               # Blender 4.3 and 5.2 tests (Debian 13 and sid folders)
+  debootstrap                               # Debian 13, sid (Blender 4.3, 5.2) and 12 (the .deb) folders
   dpkg-dev                                  # the Debian package (scripts/package.sh: dpkg-shlibdeps)
   xvfb xauth                                # the add-on tests in Blender's UI (xvfb-run)
   slurmctld slurmd slurm-client munge       # the farm test (a Slurm cluster on localhost)
