@@ -1,18 +1,13 @@
 # SPDX-License-Identifier: MIT
 # The Debian package (CPack's DEB generator): one package, ssao, with everything `cmake --install`
 # installs (the library, its headers, CMake package and pkg-config file, the image codec module,
-# ssao, povray-ssao and the Python module ssao). scripts/package.sh builds it in a tree of its own configured with the
-# prefix /usr, so that GNUInstallDirs gives the multiarch libdir (lib/x86_64-linux-gnu) and the
-# tools' run path ($ORIGIN/../${CMAKE_INSTALL_LIBDIR}) points there; docs/install.md.
+# ssao, povray-ssao and the Python module ssao). scripts/package.sh builds it in a tree of its
+# own configured with the prefix /usr, so that GNUInstallDirs gives the multiarch libdir
+# (lib/x86_64-linux-gnu) and the tools' run path ($ORIGIN/../${CMAKE_INSTALL_LIBDIR}) points
+# there; docs/install.md.
 #
 # Run-time dependencies come from dpkg-shlibdeps (libopenimageio2.4, libtbb12, libstdc++6, ...),
 # so `apt-get install ./ssao_VERSION_ARCH.deb` pulls what it needs from Debian's archive.
-
-# ssao_static exposes the internals to the tests and is installed nowhere: a build without tests
-# (scripts/package.sh's) need not compile the library a second time (a third of its compile time).
-if(NOT SSAO_BUILD_TESTS AND TARGET ssao_static)
-  set_target_properties(ssao_static PROPERTIES EXCLUDE_FROM_ALL ON)
-endif()
 
 set(SSAO_PACKAGE_MAINTAINER
     "ssao maintainers <maintainers@users.noreply.h-seed-0f0aa172.example>"
