@@ -10,8 +10,9 @@
 # run-time dependencies and that the tools' run path points at the multiarch libdir; then copies
 # the clean folder to a temporary one and, chrooted into the copy, installs the package with
 # apt-get (its dependencies come from Debian's archive), runs `ssao --version`,
-# `povray-ssao --version`, `pkg-config --modversion ssao`, `import ssao` in python3 and `ssao` on
-# the bundled sample, whose AO must equal BUILD_DIR/bin/ssao's bit for bit, and purges it again.
+# `povray-ssao --version`, `pkg-config --modversion ssao`, `import ssao` in python3 (with
+# Debian's python3-numpy) and its ambient_occlusion() and `ssao` on the bundled sample, whose AO
+# must both equal BUILD_DIR/bin/ssao's bit for bit, and purges it again.
 # The clean folder is never written to: a copy is, and removed at the end.
 #
 # Why a debootstrap folder: the host has every build dependency, so installing there proves
@@ -211,12 +212,25 @@ inside=/tmp/ssao-deb-test
 mkdir -p "$work/root$inside"
 sample="$source/tests/data/sample"
 cp "$deb" "$sample.exr" "$sample.camera.json" "$work/root$inside/"
+# The sample's depth and normal passes as .npy files, for the Python module inside (Debian's
+# python3-numpy there, no OpenImageIO).
+/usr/bin/python3 - "$sample.exr" "$work/root$inside" <<'PY' || fail "writing the sample's passes as .npy"
+import sys
+import numpy as np
+import OpenImageIO as oiio
+image = oiio.ImageInput.open(sys.argv[1])
+names, pixels = list(image.spec().channelnames), image.read_image(oiio.FLOAT)
+k = names.index("ViewLayer.Normal.X")
+np.save(sys.argv[2] + "/depth.npy", pixels[:, :, names.index("ViewLayer.Depth.Z")])
+np.save(sys.argv[2] + "/normals.npy", pixels[:, :, k:k + 3])
+PY
 chmod -R a+rX "$work/root$inside"
 t=$(now)
 (
   flock -w 600 8 || fail "timed out waiting for another run's apt-get ($ROOT.apt-cache.lock)"
   in_root "$work/root" /bin/sh -c "apt-get update -q &&
-    apt-get install -y -q --no-install-recommends $inside/$(basename "$deb") pkg-config python3" \
+    apt-get install -y -q --no-install-recommends $inside/$(basename "$deb") pkg-config \
+      python3-numpy" \
     > "$work/apt.log" 2>&1 ||
     { tail -n 30 "$work/apt.log" >&2
       fail "apt-get install ./$(basename "$deb") in Debian 12 (log above)"; }
@@ -224,8 +238,8 @@ t=$(now)
 t_apt=$(since "$t")
 say "apt-get install in $t_apt ($(grep -c '^Setting up ' "$work/apt.log") packages set up)"
 
-# Inside: the tools from PATH, the library known to ld.so, pkg-config, the Python module (no
-# numpy: it loads the library only), the sample.
+# Inside: the tools from PATH, the library known to ld.so, pkg-config, the Python module (its
+# library, then its AO of the sample), the sample.
 version=$(sed -n 's/^project(ssao VERSION \([0-9.]*\).*/\1/p' "$source/CMakeLists.txt")
 t=$(now)
 # shellcheck disable=SC2016 # expanded by the inner shell
@@ -246,6 +260,11 @@ in_root "$work/root" /bin/sh -euc '
   [ "$(cat python.txt)" = "python3: ssao $version /usr/$libdir/libssao.so.0" ] ||
     fail "the Python module: $(cat python.txt), not ssao $version /usr/$libdir/libssao.so.0"
   cat python.txt
+  python3 -c "import json, numpy as np, ssao
+camera = json.load(open(\"sample.camera.json\"))
+ao = ssao.ambient_occlusion(np.load(\"depth.npy\"), normals=np.load(\"normals.npy\"),
+                            camera=camera, radius=0.8)
+np.save(\"python_ao.npy\", ao)" || fail "ssao.ambient_occlusion on the sample"
   ssao sample.exr --camera sample.camera.json --radius 0.8 --ao-only -o installed.exr --quiet ||
     fail "ssao on the sample"
 ' inside "$inside" "$version" "$libdir" > "$work/inside.log" 2>&1 ||
@@ -263,6 +282,14 @@ import OpenImageIO as oiio
 a, b = (oiio.ImageBuf(p).get_pixels(oiio.FLOAT) for p in sys.argv[1:3])
 sys.exit(0 if a.shape == b.shape and np.array_equal(a, b) and a.size > 0 else 1)
 PY
+/usr/bin/python3 - "$work/root$inside/python_ao.npy" "$work/built.exr" <<'PY' ||
+  fail "the packaged Python module's AO differs from $build/bin/ssao's"
+import sys
+import numpy as np
+import OpenImageIO as oiio
+a, b = np.load(sys.argv[1]), oiio.ImageBuf(sys.argv[2]).get_pixels(oiio.FLOAT)[:, :, 0]
+sys.exit(0 if a.shape == b.shape and np.array_equal(a, b) and a.size > 0 else 1)
+PY
 
 # And out again: nothing of it is left after a purge.
 in_root "$work/root" dpkg --purge ssao > "$work/purge.log" 2>&1 ||
@@ -272,6 +299,6 @@ while read -r f; do
     fail "${f#./} is left after dpkg --purge ssao"
 done < "$work/packaged.txt"
 
-say "ok: $(basename "$deb") installs on a clean Debian 12 with apt-get, its ssao's AO equals" \
-  "the build tree's (package $t_package, copy $t_copy, apt-get $t_apt, tools $t_run," \
+say "ok: $(basename "$deb") installs on a clean Debian 12 with apt-get; the AO of its ssao" \
+  "and of its Python module equals the build tree's (package $t_package, copy $t_copy, apt-get $t_apt, tools $t_run," \
   "total $(since "$t_start"))"
