@@ -60,14 +60,9 @@ def read_passes(path):
 
 
 def camera_parameters(path):
+    """A camera file's library parameters, as the CLI and the module read it."""
     with open(path) as f:
-        cam = json.load(f)
-    params = {"camera_type": cam["type"], "camera_to_world": [v for row in cam["matrix_world"]
-                                                              for v in row]}
-    for name in ("lens", "sensor_width", "sensor_height", "sensor_fit", "shift_x", "shift_y",
-                 "ortho_scale", "clip_end"):
-        params[name] = cam[name]
-    return params
+        return ssao.camera_parameters(json.load(f))
 
 
 def parse_sets(items):
