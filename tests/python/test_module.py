@@ -10,6 +10,7 @@ test runs on an installed module (tests/install/test_install.sh passes PREFIX's)
 """
 import json
 import os
+import pathlib
 import subprocess
 import sys
 import tempfile
@@ -175,6 +176,24 @@ class OtherInputs(unittest.TestCase):
         self.assertTrue(np.all(ao[:20] == 1.0))
         self.assertTrue(np.all(np.isfinite(ao)))
 
+    def test_camera_file_path(self):
+        with_dict = ssao.ambient_occlusion(self.depth, camera=self.camera, radius=0.8)
+        for path in (SAMPLE + ".camera.json", pathlib.Path(SAMPLE + ".camera.json")):
+            np.testing.assert_array_equal(
+                ssao.ambient_occlusion(self.depth, camera=path, radius=0.8), with_dict)
+        with tempfile.TemporaryDirectory() as folder:
+            bad = os.path.join(folder, "bad.json")
+            for text, pattern in (('{"lens": NaN}', r"malformed JSON: NaN is not JSON"),
+                                  ('{"lens": 35', r"malformed JSON"),
+                                  ('[1, 2]', r"expected a JSON object, got list")):
+                with open(bad, "w") as f:
+                    f.write(text)
+                with self.assertRaisesRegex(ssao.SSAOError, "camera file '.*bad.json': " + pattern):
+                    ssao.ambient_occlusion(self.depth, camera=bad, radius=0.8)
+            with self.assertRaisesRegex(ssao.SSAOError, r"camera file '.*none.json': No such file"):
+                ssao.ambient_occlusion(self.depth, camera=os.path.join(folder, "none.json"),
+                                       radius=0.8)
+
     def test_module_facts(self):
         self.assertRegex(ssao.version(), r"^\d+\.\d+\.\d+$")
         names = {p["name"] for p in ssao.parameters()}
@@ -255,7 +274,7 @@ class BadInput(unittest.TestCase):
         self.refused(r"missing key 'matrix_world', which world-space normals need",
                      normals=self.normals, camera={k: v for k, v in self.camera.items()
                                                    if k != "matrix_world"})
-        self.refused(r"camera must be a dict", camera="sample.camera.json")
+        self.refused(r"camera must be a dict .* or a camera file's path, got int", camera=3)
         self.refused(r"camera: parameter 'shift_x' must be a number, got str",
                      camera=dict(self.camera, shift_x="0"))
         with warnings.catch_warnings(record=True) as caught:

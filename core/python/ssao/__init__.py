@@ -10,15 +10,17 @@ keywords are the library's parameters (ssao.parameters()). The result is the AO,
 (height, width), 1 = unoccluded: the same bits `build/bin/ssao` writes for the same inputs.
 Every library error is an ssao.SSAOError carrying the library's message. docs/python.md.
 """
+import json
 import math
 import numbers
+import os
 import warnings
 
 from ._binding import (PARAM_FLOAT, PARAM_FLOATS, PARAM_INT, PARAM_STRING, Job, SSAOError,
                        image_layout_error, library, load_library)
 from . import _binding
 
-__all__ = ["ambient_occlusion", "camera_parameters", "parameters", "variants", "version",
+__all__ = ["ambient_occlusion", "camera_parameters", "read_camera", "parameters", "variants", "version",
            "library", "load_library", "Job", "SSAOError", "image_layout_error",
            "PARAM_INT", "PARAM_FLOAT", "PARAM_STRING", "PARAM_FLOATS"]
 _NO_GEOMETRY = ("the depth has no geometry pixel (every value is NaN, infinite, <= 0, or at "
@@ -98,14 +100,33 @@ def _camera_matrix(key, value):
     return [float(v) for v in matrix.ravel()]
 
 
+def read_camera(path):
+    """The dict of a camera file (JSON). SSAOError, naming the file, when it cannot be read, is
+    not JSON (NaN and Infinity are not JSON either: the CLI refuses them too) or is not an
+    object."""
+    def refuse(constant):
+        raise ValueError(f"{constant} is not JSON")
+    try:
+        with open(path, encoding="utf-8") as f:
+            camera = json.load(f, parse_constant=refuse)
+    except OSError as error:
+        raise SSAOError(f"camera file '{os.fspath(path)}': {error.strerror or error}") from None
+    except ValueError as error:  # JSONDecodeError, UnicodeDecodeError, refuse()
+        raise SSAOError(f"camera file '{os.fspath(path)}': malformed JSON: {error}") from None
+    if not isinstance(camera, dict):
+        raise SSAOError(f"camera file '{os.fspath(path)}': expected a JSON object, got "
+                        f"{type(camera).__name__}")
+    return camera
+
+
 def camera_parameters(camera):
     """The library parameters (name -> value) of a camera file's dict, checked as `ssao --camera`
     checks the file: SSAOError for a missing key the projection needs, a value of the wrong
     type or not finite; a key the format does not know is warned about and ignored.
     "ao_distance" is not among them (ambient_occlusion() uses it as the default radius)."""
     if not isinstance(camera, dict):
-        raise SSAOError(f"camera must be a dict (a camera file's keys), got "
-                        f"{type(camera).__name__}")
+        raise SSAOError(f"camera must be a dict (a camera file's keys) or a camera file's "
+                        f"path, got {type(camera).__name__}")
     known = _camera_keys()
     for key in camera:
         if key not in known and key not in _CAMERA_ONLY:
@@ -157,8 +178,9 @@ def ambient_occlusion(depth, *, normals=None, camera, depth_layers=(), facing_la
                    background (AO 1), as in the library's contract.
     normals        float32 (H, W, 3), optional: the normal pass (normal_space="world", the
                    default, needs the camera's "matrix_world"); None rebuilds them from depth.
-    camera         the dict of a camera file (ssao --camera), or None to give the camera by
-                   its library parameters (lens, sensor_width, ...) among `parameters`.
+    camera         the dict of a camera file (ssao --camera), or its path (read_camera), or
+                   None to give the camera by its library parameters (lens, sensor_width, ...)
+                   among `parameters`.
     depth_layers   float32 (H, W) arrays: the 2nd, 3rd, ... surface hits ("depth2", ...).
     facing_layers  float32 (H, W) arrays: 1 where that hit is a back face ("facing2", ...).
     beauty         float32 (h, w) or (h, w, 1..4), optional: then (ao, composite) is returned,
@@ -199,6 +221,8 @@ def ambient_occlusion(depth, *, normals=None, camera, depth_layers=(), facing_la
         if ambient.shape != beauty.shape:
             raise SSAOError(f"ambient has shape {ambient.shape}, beauty {beauty.shape}")
 
+    if isinstance(camera, (str, os.PathLike)):
+        camera = read_camera(camera)
     settings = camera_parameters(camera) if camera is not None else {}
     ao = np.empty(frame, np.float32)
     composite = np.empty(beauty.shape, np.float32) if beauty is not None else None
