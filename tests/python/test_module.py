@@ -283,6 +283,38 @@ class BadInput(unittest.TestCase):
                                    radius=0.8)
         self.assertIn("unknown key 'focus' ignored", str(caught[0].message))
 
+    def test_any_view_is_read_right_or_refused(self):
+        # Views of every kind numpy makes: each gives the AO of its contiguous copy, bit for
+        # bit, or an SSAOError; never a crash, never another image.
+        rng = np.random.default_rng(24)
+        base = np.ascontiguousarray(self.depth[:64, :96])
+        normals = np.ascontiguousarray(self.normals[:64, :96])
+        read, refused = 0, 0
+        for _ in range(60):
+            rows = slice(None, None, int(rng.choice([1, 2, 3, -1, -2])))
+            cols = slice(None, None, int(rng.choice([1, 2, -1, 3])))
+            depth, normal = base[rows, cols], normals[rows, cols]
+            if rng.random() < 0.2:
+                depth, normal = depth.T, normal.transpose(1, 0, 2)
+            if rng.random() < 0.2:
+                normal = np.ascontiguousarray(normal[..., ::-1])[..., ::-1]
+            try:
+                ao = ssao.ambient_occlusion(depth, normals=normal, camera=self.camera,
+                                            radius=0.8)
+            except ssao.SSAOError as error:
+                self.assertRegex(str(error), "np.ascontiguousarray")
+                refused += 1
+                continue
+            expected = ssao.ambient_occlusion(np.ascontiguousarray(depth),
+                                              normals=np.ascontiguousarray(normal),
+                                              camera=self.camera, radius=0.8)
+            self.assert_same_bits(ao, expected)
+            read += 1
+        self.assertGreater(read, 10)
+        self.assertGreater(refused, 5)
+
+    assert_same_bits = AgainstCli.assert_same_bits
+
     def test_empty_images(self):
         self.refused(r"depth must have 2 dimensions", np.zeros((0,), np.float32))
         self.refused(r"no geometry pixel", np.zeros((0, 0), np.float32))
