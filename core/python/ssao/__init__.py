@@ -20,8 +20,8 @@ from ._binding import (PARAM_FLOAT, PARAM_FLOATS, PARAM_INT, PARAM_STRING, Job, 
                        image_layout_error, library, load_library)
 from . import _binding
 
-__all__ = ["ambient_occlusion", "camera_parameters", "read_camera", "parameters", "variants", "version",
-           "library", "load_library", "Job", "SSAOError", "image_layout_error",
+__all__ = ["ambient_occlusion", "read_camera", "camera_parameters", "parameters", "variants",
+           "version", "library", "load_library", "Job", "SSAOError", "image_layout_error",
            "PARAM_INT", "PARAM_FLOAT", "PARAM_STRING", "PARAM_FLOATS"]
 _NO_GEOMETRY = ("the depth has no geometry pixel (every value is NaN, infinite, <= 0, or at "
                 "least background_depth or clip_end): is it the depth pass?")
@@ -54,9 +54,10 @@ _CAMERA_ONLY = ("ao_distance",)  # the AO radius the shot was made for: not a ca
 
 
 def _camera_keys():
+    """{camera file key: library parameter} for every camera parameter of the library."""
     names = [p["name"] for p in parameters() if p["group"] == "camera"]
-    renamed = {library: key for key, library in _CAMERA_RENAMED.items()}
-    return {renamed.get(name, name): name for name in names}
+    key_of = {param: key for key, param in _CAMERA_RENAMED.items()}
+    return {key_of.get(name, name): name for name in names}
 
 
 def _required_camera_keys(camera):
