@@ -81,8 +81,12 @@ PY
 
 # The installed Python module: it finds the installed library by itself (no SSAO_LIBRARY, no
 # build tree on its search path), and passes the module's test against the installed ssao.
-pythondir="$prefix/lib/python3/dist-packages"
-[ -f "$pythondir/ssao/__init__.py" ] || fail "the Python module ssao is not installed in $pythondir"
+module=$(find "$prefix" -path '*/dist-packages/ssao/__init__.py' | head -1)
+[ -n "$module" ] || fail "the Python module ssao is not installed (no */dist-packages/ssao)"
+pythondir=$(dirname "$(dirname "$module")")
+# Installed with the prefix /usr/local, it would be on Debian's python3's own path.
+/usr/bin/python3 -c 'import sys; sys.exit(sys.argv[1] not in sys.path)' "/usr/local/${pythondir#"$prefix"/}" ||
+  fail "${pythondir#"$prefix"/} under /usr/local is not on Debian python3's sys.path"
 found=$(cd "$work" && env -u SSAO_LIBRARY PYTHONPATH="$pythondir" /usr/bin/python3 -c \
   'import ssao; print(ssao.library()._name)') || fail "import ssao from the prefix"
 case "$found" in "$prefix"/*) ;; *) fail "the installed module loaded $found, not the prefix's" ;; esac
