@@ -156,17 +156,41 @@ class OtherInputs(unittest.TestCase):
         two = ssao.ambient_occlusion(self.depth, camera=self.camera, radius=0.8,
                                      variant="hemisphere", depth_layers=[behind])
         self.assertGreater(np.count_nonzero(one != two), 100)
-        with self.assertRaisesRegex(ssao.SSAOError, "nearer"):
-            ssao.ambient_occlusion(self.depth, camera=self.camera, radius=0.8,
-                                   variant="hemisphere", depth_layers=[self.depth * 0.5])
+        generator = ssao.ambient_occlusion(self.depth, camera=self.camera, radius=0.8,
+                                           variant="hemisphere",
+                                           depth_layers=(layer for layer in [behind]))
+        np.testing.assert_array_equal(generator, two)  # an iterator is not used up by checks
+        for layers in ([self.depth * 0.5], iter([self.depth * 0.5])):
+            with self.assertRaisesRegex(ssao.SSAOError, "nearer"):
+                ssao.ambient_occlusion(self.depth, camera=self.camera, radius=0.8,
+                                       variant="hemisphere", depth_layers=layers)
 
     def test_progress_and_cancel(self):
         seen = []
         ssao.ambient_occlusion(self.depth, camera=self.camera, radius=0.8, progress=seen.append)
         self.assertTrue(seen and seen[-1] == 1.0 and seen == sorted(seen), seen)
-        with self.assertRaisesRegex(ssao.SSAOError, "cancelled"):
+        for stop in (False, 0, np.False_):
+            with self.assertRaisesRegex(ssao.SSAOError, "cancelled"):
+                ssao.ambient_occlusion(self.depth, camera=self.camera, radius=0.8,
+                                       progress=lambda fraction: stop)
+
+    def test_an_exception_in_progress_is_raised_as_it_was(self):
+        calls = []
+
+        def failing(fraction, at):
+            calls.append(fraction)
+            if fraction >= at:
+                raise ValueError(f"stop at {fraction}")
+
+        for at in (0.0, 1.0):  # the first call, and the last (after the AO is complete)
+            calls.clear()
+            with self.assertRaisesRegex(ValueError, "stop at"):
+                ssao.ambient_occlusion(self.depth, camera=self.camera, radius=0.8,
+                                       progress=lambda f: failing(f, at))
+            self.assertEqual(calls[-1], max(calls))  # not called again after it raised
+        with self.assertRaises(KeyboardInterrupt):
             ssao.ambient_occlusion(self.depth, camera=self.camera, radius=0.8,
-                                   progress=lambda fraction: False)
+                                   progress=lambda f: (_ for _ in ()).throw(KeyboardInterrupt))
 
     def test_background_pixels(self):
         depth = np.array(self.depth)
@@ -193,6 +217,26 @@ class OtherInputs(unittest.TestCase):
             with self.assertRaisesRegex(ssao.SSAOError, r"camera file '.*none.json': No such file"):
                 ssao.ambient_occlusion(self.depth, camera=os.path.join(folder, "none.json"),
                                        radius=0.8)
+
+    def test_a_named_library_is_that_one_or_an_error(self):
+        with self.assertRaisesRegex(ssao.SSAOError, "cannot load libssao /typo/libssao.so: "
+                                                    "not found"):
+            ssao.load_library("/typo/libssao.so")
+        env = dict(os.environ, SSAO_LIBRARY="/typo/libssao.so",
+                   PYTHONPATH=os.path.abspath(MODULE_FOLDER))
+        result = subprocess.run([sys.executable, "-c", "import ssao; ssao.version()"], env=env,
+                                capture_output=True, text=True)
+        self.assertNotEqual(result.returncode, 0)
+        self.assertIn("/typo/libssao.so ($SSAO_LIBRARY): not found", result.stderr)
+
+    def test_job_reads_back_parameters(self):
+        matrix = [float(v) for v in np.arange(12)] + [0.0, 0.0, 0.0, 1.0]
+        with ssao.Job() as job:
+            job.set("camera_to_world", np.array(matrix).reshape(4, 4))
+            job.set("radius", np.float32(0.5))
+            job.set("samples", np.int64(12))
+            self.assertEqual(job.get("camera_to_world"), matrix)
+            self.assertEqual((job.get("radius"), job.get("samples")), (0.5, 12))
 
     def test_module_facts(self):
         self.assertRegex(ssao.version(), r"^\d+\.\d+\.\d+$")
@@ -232,7 +276,11 @@ class BadInput(unittest.TestCase):
         self.refused(r"depth_layers\[0\] has shape", depth_layers=[self.contiguous[1:]])
         self.refused(r"beauty has shape", beauty=self.beauty[1:])
         self.refused(r"output_window must be \(x, y, width, height\)", output_window=(1, 2))
+        self.refused(r"output_window must be .* whole pixels", output_window=(20.7, 0, 10, 10))
         self.refused(r"output window.*does not fit", output_window=(200, 0, 100, 100))
+        self.refused(r"output window.*does not fit", output_window=(2**32 + 20, 0, 10, 10))
+        self.refused(r"output window.*does not fit", output_window=(0, 0, 200000, 200000))
+        self.refused(r"output window.*does not fit", output_window=(0, 0, -10, 10))
 
     def test_layouts_the_library_cannot_read_in_place(self):
         self.refused(r"depth.*transposed.*np.ascontiguousarray", self.contiguous.T.T.T)
@@ -245,6 +293,7 @@ class BadInput(unittest.TestCase):
         unaligned = raw.view(np.float32).reshape(self.contiguous.shape)
         unaligned[...] = self.contiguous
         self.refused(r"not aligned", unaligned)
+        self.refused(r"masked array", np.ma.masked_invalid(self.contiguous))
 
     def test_nan_and_out_of_range_values(self):
         self.refused(r"'radius' must be finite, got nan", radius=float("nan"))
@@ -252,11 +301,19 @@ class BadInput(unittest.TestCase):
         self.refused(r"'threads' is out of range", threads=2**40)
         self.refused(r"'threads' must be an int, got float", threads=2.0)
         self.refused(r"'radius' must be a number, got str", radius="0.8")
-        self.refused(r"camera: .*'lens' must be finite, got nan",
+        self.refused(r"camera key 'lens' must be a finite number, got nan",
                      camera=dict(self.camera, lens=float("nan")))
+        self.refused(r"camera key 'lens' must be a finite number", camera=dict(self.camera,
+                                                                               lens=10**400))
+        self.refused(r"'radius' is out of range", radius=10**400)
+        self.refused(r"camera key 'clip_end' must be positive, got 0",  # the CLI's rule
+                     camera=dict(self.camera, clip_end=0))
+        self.refused(r"camera key 'clip_start' must not be negative",
+                     camera=dict(self.camera, clip_start=-1.0))
         self.refused(r"camera key 'ao_distance' must be a finite number",
                      camera=dict(self.camera, ao_distance=float("inf")), radius=None)
-        self.refused(r"camera: .*lens.*must be in", camera=dict(self.camera, lens=-35.0))
+        self.refused(r"camera key 'lens' must be positive", camera=dict(self.camera, lens=-35.0))
+        self.refused(r"camera: .*'shift_x' must be in", camera=dict(self.camera, shift_x=5000))
         self.refused(r"no geometry pixel", np.full_like(self.contiguous, np.nan))
         self.refused(r"no geometry pixel", np.full_like(self.contiguous, np.nan), radius=None)
 
@@ -271,9 +328,25 @@ class BadInput(unittest.TestCase):
             self.camera, matrix_world=[[1, 0, 0], [0, 1, 0], [0, 0, 1]]))
         self.refused(r"'matrix_world' must be an affine transform", camera=dict(
             self.camera, matrix_world=[[1, 0, 0, 0]] * 4))
-        self.refused(r"missing key 'matrix_world', which world-space normals need",
-                     normals=self.normals, camera={k: v for k, v in self.camera.items()
-                                                   if k != "matrix_world"})
+        no_matrix = {k: v for k, v in self.camera.items() if k != "matrix_world"}
+        self.refused(r"missing the camera's matrix .* which world-space normals need",
+                     normals=self.normals, camera=no_matrix)
+        self.refused(r"missing the camera's matrix", normals=self.normals, camera=None,
+                     lens=35.0)
+        self.refused(r"camera key 'intrinsics' must be a number, got str", camera={
+            "projection": "intrinsics", "type": "PERSP", "intrinsics": ["100", 100, 120, 67]})
+        self.refused(r"camera key 'matrix_world' must be a number, got bool", camera=dict(
+            self.camera, matrix_world=[[True, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, 0],
+                                       [0, 0, 0, 1]]))
+        self.refused(r"'camera_to_world' must be a sequence of numbers, got set",
+                     camera=no_matrix, camera_to_world={1.0, 2.0})
+        # The matrix as a parameter (any array shape of 16 numbers) stands for the camera's.
+        matrix = np.array(self.camera["matrix_world"])
+        np.testing.assert_array_equal(
+            ssao.ambient_occlusion(self.contiguous, normals=self.normals, camera=no_matrix,
+                                   camera_to_world=matrix, radius=0.8),
+            ssao.ambient_occlusion(self.contiguous, normals=self.normals, camera=self.camera,
+                                   radius=0.8))
         self.refused(r"camera must be a dict .* or a camera file's path, got int", camera=3)
         self.refused(r"camera: parameter 'shift_x' must be a number, got str",
                      camera=dict(self.camera, shift_x="0"))
@@ -317,6 +390,7 @@ class BadInput(unittest.TestCase):
 
     def test_empty_images(self):
         self.refused(r"depth must have 2 dimensions", np.zeros((0,), np.float32))
+        self.refused(r"no geometry pixel", np.zeros((0, 5), np.float32))
         self.refused(r"no geometry pixel", np.zeros((0, 0), np.float32))
         self.refused(r"no geometry pixel", np.zeros((0, 0), np.float32), radius=None)
 

@@ -51,6 +51,11 @@ def variants(lib=None):
 _CAMERA_RENAMED = {"type": "camera_type", "matrix_world": "camera_to_world"}
 _CAMERA_MATRICES = {"matrix_world": (4, 4), "projection_matrix": (4, 4), "intrinsics": (4,)}
 _CAMERA_ONLY = ("ao_distance",)  # the AO radius the shot was made for: not a camera parameter
+# Numbers the camera file requires positive or not negative (camera_json.cpp's checks; the
+# library's own ranges allow clip_end 0, "no clip test", which a file cannot say).
+_CAMERA_POSITIVE = ("lens", "sensor_width", "sensor_height", "ortho_scale", "clip_end",
+                    "pixel_aspect_x", "pixel_aspect_y", "ao_distance")
+_CAMERA_NOT_NEGATIVE = ("clip_start",)
 
 
 def _camera_keys():
@@ -78,23 +83,27 @@ def _required_camera_keys(camera):
 def _camera_number(key, value):
     if isinstance(value, bool) or not isinstance(value, numbers.Real):
         raise SSAOError(f"camera key '{key}' must be a number, got {type(value).__name__}")
-    if not math.isfinite(value):
+    try:
+        number = float(value)
+    except OverflowError:
+        number = math.inf
+    if not math.isfinite(number):
         raise SSAOError(f"camera key '{key}' must be a finite number, got {value}")
-    return float(value)
+    return number
 
 
 def _camera_matrix(key, value):
     import numpy as np
     shape = _CAMERA_MATRICES[key]
+    rows = "an array of 4 numbers" if shape == (4,) else "a 4x4 matrix (4 rows of 4 numbers)"
     try:
-        matrix = np.array(value, dtype=np.float64)
-    except (TypeError, ValueError):
+        matrix = np.array(value, dtype=object)
+    except ValueError:  # ragged nesting
         matrix = None
     if matrix is None or matrix.shape != shape:
-        rows = "an array of 4 numbers" if shape == (4,) else "a 4x4 matrix (4 rows of 4 numbers)"
         raise SSAOError(f"camera key '{key}' must be {rows}")
-    if not np.isfinite(matrix).all():
-        raise SSAOError(f"camera key '{key}' must hold finite numbers")
+    # Numbers only, as in the file (np.array(..., float) would take "1" and True).
+    matrix = np.array([_camera_number(key, v) for v in matrix.ravel()]).reshape(shape)
     if key == "matrix_world" and list(matrix[3]) != [0.0, 0.0, 0.0, 1.0]:
         raise SSAOError("camera key 'matrix_world' must be an affine transform: its last row "
                         "must be [0, 0, 0, 1]")
@@ -138,10 +147,13 @@ def camera_parameters(camera):
                             "(scripts/blender/export_cameras.py writes every key)")
     params = {}
     for key, value in camera.items():
+        if key in _CAMERA_POSITIVE and not _camera_number(key, value) > 0.0:
+            raise SSAOError(f"camera key '{key}' must be positive, got {value}")
+        if key in _CAMERA_NOT_NEGATIVE and _camera_number(key, value) < 0.0:
+            raise SSAOError(f"camera key '{key}' must not be negative, got {value}")
         if key in _CAMERA_ONLY:
-            if _camera_number(key, value) <= 0.0:
-                raise SSAOError(f"camera key '{key}' must be positive, got {value}")
-        elif key in _CAMERA_MATRICES:
+            continue
+        if key in _CAMERA_MATRICES:
             params[known[key]] = _camera_matrix(key, value)
         elif key in known:
             params[known[key]] = value  # Job.set checks the type, the library the value
@@ -199,14 +211,12 @@ def ambient_occlusion(depth, *, normals=None, camera, depth_layers=(), facing_la
     geometry pixel) and never returns a partial image.
     """
     import numpy as np
+    depth_layers, facing_layers = list(depth_layers), list(facing_layers)  # iterated twice
     _check_image("depth", depth, None, channels=(1,))
     shape = depth.shape[:2]
     frame = shape
     if output_window is not None:
-        try:
-            x, y, width, height = (int(v) for v in output_window)
-        except (TypeError, ValueError):
-            raise SSAOError("output_window must be (x, y, width, height)") from None
+        x, y, width, height = _window(output_window, shape)
         frame = (height, width)
     if normals is not None:
         _check_image("normals", normals, shape, channels=(3, 4))
@@ -245,7 +255,7 @@ def ambient_occlusion(depth, *, normals=None, camera, depth_layers=(), facing_la
             if ambient is not None:
                 job.set_image("ambient", ambient)
             job.set_image("composite", composite)
-        _require_matrix_world(job, normals, camera)
+        _require_matrix_world(job, normals, camera, parameters)
         if "radius" not in parameters:
             job.set("radius", _default_radius(job, camera))
         job.run(progress)
@@ -254,15 +264,36 @@ def ambient_occlusion(depth, *, normals=None, camera, depth_layers=(), facing_la
     return (ao, composite) if beauty is not None else ao
 
 
-def _require_matrix_world(job, normals, camera):
+def _window(output_window, shape):
+    """(x, y, width, height) of an output window inside a depth image of `shape`: integers (no
+    float is rounded), checked before the outputs are allocated."""
+    try:
+        values = tuple(output_window)
+    except TypeError:
+        values = ()
+    if len(values) != 4 or not all(isinstance(v, numbers.Integral) and not isinstance(v, bool)
+                                   for v in values):
+        raise SSAOError(f"output_window must be (x, y, width, height) in whole pixels, got "
+                        f"{output_window!r}")
+    x, y, width, height = (int(v) for v in values)
+    if min(values) < 0 or x + width > shape[1] or y + height > shape[0]:
+        raise SSAOError(f"output window {width}x{height} at ({x}, {y}) does not fit in the "
+                        f"{shape[1]}x{shape[0]} depth image")
+    return x, y, width, height
+
+
+def _require_matrix_world(job, normals, camera, parameters):
     """World-space normals without the camera's matrix would be turned by the identity: a
-    silently wrong AO, so refused (as the CLI refuses it)."""
-    if normals is None or camera is None or "matrix_world" in camera:
+    silently wrong AO, so refused (as the CLI refuses it), whether the matrix would come from
+    the camera ("matrix_world") or the parameters ("camera_to_world")."""
+    has_matrix = (camera is not None and "matrix_world" in camera) or \
+        "camera_to_world" in parameters
+    if normals is None or has_matrix or job.get("normal_space") != "world":
         return
-    if job.get("normal_space") == "world":
-        raise SSAOError("camera: missing key 'matrix_world', which world-space normals need; "
-                        "add it, or pass normal_space='camera' for view-space normals, or "
-                        "normals=None to rebuild them from depth")
+    raise SSAOError("missing the camera's matrix ('matrix_world' of the camera, or the "
+                    "parameter camera_to_world), which world-space normals need; add it, or "
+                    "pass normal_space='camera' for view-space normals, or normals=None to "
+                    "rebuild them from depth")
 
 
 def _default_radius(job, camera):

@@ -50,16 +50,11 @@ PARAM_INT, PARAM_FLOAT, PARAM_STRING, PARAM_FLOATS = 0, 1, 2, 3
 _PROGRESS_FN = ctypes.CFUNCTYPE(ctypes.c_int, ctypes.c_void_p, ctypes.c_double)
 
 
-def _candidate_paths(path):
-    """Where libssao may be, in order: the caller's path, $SSAO_LIBRARY, a lib/ folder beside this
-    package (how the Blender add-on bundles it), where `cmake --install` put it (_installed.py,
-    written at install time), the source tree's
-    build/lib/ (this file is core/python/ssao/ there); and last the system's loader by SONAME
-    (a library in a standard folder or on LD_LIBRARY_PATH)."""
-    if path:
-        yield path
-    if os.environ.get("SSAO_LIBRARY"):
-        yield os.environ["SSAO_LIBRARY"]
+def _candidate_paths():
+    """Where libssao may be when no path is named, in order: a lib/ folder beside this package
+    (how the Blender add-on bundles it), where `cmake --install` put it (_installed.py, written
+    at install time), the source tree's build/lib/ (this file is core/python/ssao/ there); and
+    last the system's loader by SONAME (a standard folder or LD_LIBRARY_PATH)."""
     here = os.path.dirname(os.path.abspath(__file__))
     name = _LIB_NAMES.get(sys.platform, "libssao.so")
     yield os.path.normpath(os.path.join(here, "..", "lib", name))  # bundled: the Blender add-on
@@ -84,25 +79,43 @@ def library():
 
 
 def load_library(path=None):
-    """Loads libssao from the first of _candidate_paths() that exists; SSAOError, listing where
-    it looked, when none does or the library's major version is not this binding's."""
-    errors = []
-    for candidate in _candidate_paths(path):
-        if os.sep in candidate and not os.path.exists(candidate):
-            errors.append(f"{candidate}: not found")
-            continue
-        try:
-            lib = ctypes.CDLL(candidate)
-        except OSError as error:
-            errors.append(str(error))
-            continue
-        _declare(lib)
-        version = lib.ssao_version()
-        if version // 10000 != ABI_MAJOR:
-            raise SSAOError(f"{candidate} is libssao {version}, this binding needs {ABI_MAJOR}.x")
+    """Loads libssao: `path`, else $SSAO_LIBRARY, else the first of _candidate_paths() that
+    loads. A library named by `path` or $SSAO_LIBRARY is that one or an SSAOError, never another
+    found elsewhere (a typo must not compare a library with itself). SSAOError, listing where it
+    looked, when none loads, or when the library's major version is not this binding's."""
+    named = path or os.environ.get("SSAO_LIBRARY")
+    if named:
+        lib = _open(named)
+        if isinstance(lib, str):
+            what = "" if path else " ($SSAO_LIBRARY)"
+            raise SSAOError(f"cannot load libssao {named}{what}: {lib}")
         return lib
+    errors = []
+    for candidate in _candidate_paths():
+        lib = _open(candidate)
+        if not isinstance(lib, str):
+            return lib
+        errors.append(f"{candidate}: {lib}")
     raise SSAOError("libssao not found: " + "; ".join(errors) +
                     " (set SSAO_LIBRARY to the library's path)")
+
+
+def _open(candidate):
+    """The library at `candidate` (a path, or a SONAME for the system's loader), declared and
+    version-checked; or, when it cannot be loaded, why (a str)."""
+    if os.sep in candidate and not os.path.exists(candidate):
+        return "not found"
+    try:
+        lib = ctypes.CDLL(candidate)
+    except OSError as error:
+        return str(error)
+    if not hasattr(lib, "ssao_version"):
+        return "not libssao (no ssao_version)"
+    _declare(lib)
+    version = lib.ssao_version()
+    if version // 10000 != ABI_MAJOR:
+        raise SSAOError(f"{candidate} is libssao {version}, this binding needs {ABI_MAJOR}.x")
+    return lib
 
 
 def _declare(lib):
@@ -137,6 +150,7 @@ def _declare(lib):
     sig("ssao_job_get_int", c_int, job, cstr, ctypes.POINTER(c_int))
     sig("ssao_job_get_float", c_int, job, cstr, ctypes.POINTER(c_double))
     sig("ssao_job_get_string", c_int, job, cstr, ctypes.c_char_p, ctypes.c_size_t)
+    sig("ssao_job_get_floats", c_int, job, cstr, ctypes.POINTER(c_double), ctypes.c_size_t)
     sig("ssao_job_set_image", c_int, job, cstr, ctypes.c_void_p, c_int, c_int, c_int,
         ctypes.c_ssize_t, ctypes.c_ssize_t)
     if hasattr(lib, "ssao_job_set_output_window"):  # since 0.1 after 7bf6fcd (overscan)
@@ -160,6 +174,8 @@ def image_layout_error(array, writable=False):
     import numpy as np
     if not isinstance(array, np.ndarray):
         return f"must be a numpy array, got {type(array).__name__}"
+    if isinstance(array, np.ma.MaskedArray):  # the library would read the masked values
+        return "is a masked array: fill it first, e.g. .filled(np.nan) (NaN depth is background)"
     if array.dtype != np.float32:
         return f"must be float32 (native byte order), got {array.dtype}; use .astype(np.float32)"
     if array.ndim not in (2, 3):
@@ -167,6 +183,10 @@ def image_layout_error(array, writable=False):
                f"got shape {array.shape}"
     height, width = array.shape[:2]
     channels = array.shape[2] if array.ndim == 3 else 1
+    if max(height, width) >= 2**31:
+        return f"is too large for the library (shape {array.shape}: sides below 2^31)"
+    if array.size == 0:
+        return None  # no pixel to address: the library takes a 0-pixel image as it is
     pixel = 4 * channels
     fix = "; pass np.ascontiguousarray(array)"
     if array.ndim == 3 and channels > 1 and array.strides[2] != 4:
@@ -236,7 +256,30 @@ def _int_value(name, value):
 def _float_value(name, value):
     if isinstance(value, bool) or not isinstance(value, numbers.Real):
         raise SSAOError(f"parameter '{name}' must be a number, got {type(value).__name__}")
-    return float(value)  # NaN and infinity reach the library, which says what it accepts
+    try:
+        return float(value)  # NaN and infinity reach the library, which says what it accepts
+    except OverflowError:
+        raise SSAOError(f"parameter '{name}' is out of range: {value}") from None
+
+
+def _float_values(name, value):
+    """A parameter of several floats: a sequence or array of numbers (a 4x4 matrix may be
+    nested or 2-D), in row-major order; not a set or mapping, whose order means nothing."""
+    import numpy as np
+    if isinstance(value, (str, bytes, set, frozenset, dict)) or np.ndim(value) == 0:
+        raise SSAOError(f"parameter '{name}' must be a sequence of numbers, got "
+                        f"{type(value).__name__}")
+    try:
+        array = np.asarray(value)
+    except ValueError:  # ragged nesting
+        raise SSAOError(f"parameter '{name}' must be a sequence of numbers") from None
+    if array.dtype.kind not in "iuf":
+        flat = array.ravel() if array.dtype == object else ()
+        if not all(isinstance(v, numbers.Real) and not isinstance(v, bool) for v in flat) \
+                or not len(flat):
+            raise SSAOError(f"parameter '{name}' must be a sequence of numbers, got "
+                            f"{array.dtype} values")
+    return [_float_value(name, v) for v in array.ravel().tolist()]
 
 
 class Job:
@@ -248,12 +291,18 @@ class Job:
         self._lib.ssao_job_create(ctypes.byref(handle))
         self._job = handle
         self._images = {}  # keeps attached arrays alive until run() returns
-        self._types = {p["name"]: p["type"] for p in parameters(self._lib)}
+        table = parameters(self._lib)
+        self._types = {p["name"]: p["type"] for p in table}
+        self._counts = {p["name"]: p["count"] for p in table}
 
     def close(self):
         if self._job:
             self._lib.ssao_job_destroy(self._job)
             self._job = None
+
+    def __del__(self):  # a job never closed is freed with its object
+        if getattr(self, "_job", None):
+            self.close()
 
     def __enter__(self):
         return self
@@ -275,10 +324,7 @@ class Job:
                 raise SSAOError(f"parameter '{name}' must be a str, got {type(value).__name__}")
             self._lib.ssao_job_set_string(self._job, key, value.encode())
         elif kind == PARAM_FLOATS:
-            if isinstance(value, (str, bytes)) or not hasattr(value, "__len__"):
-                raise SSAOError(f"parameter '{name}' must be a sequence of numbers, got "
-                                f"{type(value).__name__}")
-            values = [_float_value(name, v) for v in value]
+            values = _float_values(name, value)
             array = (ctypes.c_double * len(values))(*values)
             self._lib.ssao_job_set_floats(self._job, key, array, len(values))
         else:
@@ -296,6 +342,11 @@ class Job:
             text = ctypes.create_string_buffer(256)
             self._lib.ssao_job_get_string(self._job, key, text, len(text))
             return text.value.decode()
+        if kind == PARAM_FLOATS:
+            count = self._counts[name]
+            values = (ctypes.c_double * count)()
+            self._lib.ssao_job_get_floats(self._job, key, values, count)
+            return list(values)
         value = ctypes.c_double()  # floats; an unknown name gets the library's message
         self._lib.ssao_job_get_float(self._job, key, ctypes.byref(value))
         return value.value
@@ -328,16 +379,31 @@ class Job:
 
     def set_output_window(self, x, y, enable=True):
         """Overscan: the outputs are the window at (x, y) of the depth image (ssao.h)."""
-        self._lib.ssao_job_set_output_window(self._job, int(enable), int(x), int(y))
+        self._lib.ssao_job_set_output_window(self._job, int(bool(enable)),
+                                             _int_value("output window x", x),
+                                             _int_value("output window y", y))
 
     def run(self, progress=None):
-        """Runs the job. progress(fraction) may return False to cancel."""
-        callback = None
+        """Runs the job. progress(fraction) is called on this thread; a false value other than
+        None (False, 0) cancels the run (SSAOError "cancelled"). An exception it raises cancels
+        the run too and is raised from here, as it was (ctypes would only print it)."""
+        callback, raised = None, []
         if progress is not None:
-            callback = _PROGRESS_FN(lambda user, f: 0 if progress(f) is False else 1)
+            def call(user, fraction):
+                try:
+                    result = progress(fraction)
+                except BaseException as error:  # KeyboardInterrupt included
+                    raised.append(error)
+                    return 0
+                return 0 if result is not None and not result else 1
+            callback = _PROGRESS_FN(call)
             self._lib.ssao_job_set_progress(self._job, callback, None)
         try:
             self._lib.ssao_job_run(self._job)
+        except SSAOError:
+            if raised:
+                raise raised[0] from None
+            raise
         finally:
             if callback is not None:
                 self._lib.ssao_job_set_progress(self._job, _PROGRESS_FN(), None)
