@@ -48,4 +48,12 @@ set(CPACK_DEBIAN_PACKAGE_GENERATE_SHLIBS_POLICY ">=")
 # povray-ssao runs POV-Ray, the Python module needs numpy; the library and ssao need neither.
 set(CPACK_DEBIAN_PACKAGE_SUGGESTS "povray, python3-numpy, pkg-config")
 
+# The module's bytecode cache, written when root imports it, is removed with the package.
+set(SSAO_PACKAGE_PYTHON_MODULE "${CPACK_PACKAGING_INSTALL_PREFIX}/${SSAO_PYTHONDIR}/ssao")
+configure_file(${CMAKE_CURRENT_LIST_DIR}/debian/prerm.in ${CMAKE_BINARY_DIR}/debian/prerm @ONLY
+               FILE_PERMISSIONS OWNER_READ OWNER_WRITE OWNER_EXECUTE GROUP_READ GROUP_EXECUTE
+                                WORLD_READ WORLD_EXECUTE)
+set(CPACK_DEBIAN_PACKAGE_CONTROL_EXTRA ${CMAKE_BINARY_DIR}/debian/prerm)
+set(CPACK_DEBIAN_PACKAGE_CONTROL_STRICT_PERMISSION ON)
+
 include(CPack)

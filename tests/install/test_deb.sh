@@ -172,7 +172,8 @@ dpkg-deb -c "$deb" | awk '$1 !~ /^d/ { print $6 }' | sort > "$work/packaged.txt"
 diff "$work/installed.txt" "$work/packaged.txt" > "$work/contents.diff" ||
   { cat "$work/contents.diff" >&2
     fail "the package's files differ from cmake --install's (<: installed only, >: packaged)"; }
-for f in usr/bin/ssao usr/bin/povray-ssao usr/include/ssao/ssao.h usr/include/ssao/ssao.hpp; do
+for f in usr/bin/ssao usr/bin/povray-ssao usr/include/ssao/ssao.h usr/include/ssao/ssao.hpp \
+  usr/share/doc/ssao/copyright; do
   grep -qx "./$f" "$work/packaged.txt" || fail "$f is not in the package"
 done
 for f in libssao.so libssao.so.0 libssao_image_codec.so pkgconfig/ssao.pc \
@@ -298,6 +299,11 @@ while read -r f; do
   [[ ! -e "$work/root/${f#./}" && ! -L "$work/root/${f#./}" ]] ||
     fail "${f#./} is left after dpkg --purge ssao"
 done < "$work/packaged.txt"
+# Nor what using it made: python3 (as root, above) wrote the module's __pycache__.
+! grep -i "warning" "$work/purge.log" || fail "dpkg --purge ssao warned (above)"
+module_dir=$(grep -m1 '/dist-packages/ssao/__init__\.py$' "$work/packaged.txt")
+[[ ! -e "$work/root/$(dirname "${module_dir#./}")" ]] ||
+  fail "$(dirname "${module_dir#./}") is left after dpkg --purge ssao"
 
 say "ok: $(basename "$deb") installs on a clean Debian 12 with apt-get; the AO of its ssao" \
   "and of its Python module equals the build tree's (package $t_package, copy $t_copy, apt-get $t_apt, tools $t_run," \
