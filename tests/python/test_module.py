@@ -57,7 +57,7 @@ def run_cli(*args, camera=None):
                 json.dump(camera, f)
         out = os.path.join(folder, "out.exr")
         subprocess.run([CLI, SAMPLE + ".exr", "--camera", camera_path, "-o", out, "--quiet",
-                        *args], check=True)
+                        *args], check=True, stderr=subprocess.DEVNULL if camera else None)
         names, pixels = read_image(out)
     return {name: pixels[:, :, k] for k, name in enumerate(names)}
 
@@ -126,6 +126,67 @@ class AgainstCli(unittest.TestCase):
             ao = ssao.ambient_occlusion(depth, normals=self.normals, camera=self.camera,
                                         radius=0.8)
             self.assert_same_bits(ao, contiguous)
+
+
+class CameraRulesAgreeWithCli(unittest.TestCase):
+    """The camera file's rules live in the CLI (core/tools/camera_json.cpp) and in the module:
+    for each variant of the sample's camera, both accept it with the same AO, or both refuse
+    it."""
+
+    def variants(self, camera):
+        intrinsics = {"projection": "intrinsics", "type": "PERSP",
+                      "intrinsics": [233.3, 233.3, 120.0, 67.5],
+                      "matrix_world": camera["matrix_world"]}
+        yield "as is", camera
+        for key in ("type", "lens", "sensor_width", "sensor_fit", "shift_x", "shift_y",
+                    "sensor_height", "ortho_scale", "clip_start", "clip_end", "matrix_world"):
+            yield f"without {key}", {k: v for k, v in camera.items() if k != key}
+        yield "ORTHO without ortho_scale", dict(
+            {k: v for k, v in camera.items() if k != "ortho_scale"}, type="ORTHO")
+        yield "VERTICAL without sensor_height", dict(
+            {k: v for k, v in camera.items() if k != "sensor_height"}, sensor_fit="VERTICAL")
+        for key, bad in (("lens", 0), ("lens", -1.0), ("lens", "35"), ("lens", True),
+                         ("lens", None), ("clip_end", 0), ("clip_start", -0.1),
+                         ("ortho_scale", 0), ("pixel_aspect_x", 0), ("shift_x", 2000.0),
+                         ("shift_x", "0"), ("type", "FISHEYE"), ("type", 1),
+                         ("sensor_fit", "auto"), ("ao_distance", 0), ("ao_distance", -1),
+                         ("ao_distance", "1"), ("projection", "pinhole"),
+                         ("matrix_world", [[1, 0, 0, 0]] * 3),
+                         ("matrix_world", [[1, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 1, 1]]),
+                         ("matrix_world", [[1, 0, 0, "0"], [0, 1, 0, 0], [0, 0, 1, 0],
+                                           [0, 0, 0, 1]])):
+            yield f"{key} = {bad!r}", dict(camera, **{key: bad})
+        yield "intrinsics", intrinsics
+        yield "intrinsics without type", {k: v for k, v in intrinsics.items() if k != "type"}
+        yield "intrinsics without intrinsics", {k: v for k, v in intrinsics.items()
+                                                if k != "intrinsics"}
+        yield "intrinsics of 3", dict(intrinsics, intrinsics=[233.3, 233.3, 120.0])
+        yield "matrix without projection_matrix", dict(camera, projection="matrix")
+
+    def test_same_verdicts_and_bits(self):
+        depth, normals, _, camera = load_sample()
+        verdicts = {True: 0, False: 0}
+        for name, variant in self.variants(camera):
+            with self.subTest(name):
+                try:
+                    cli = run_cli("--radius", "0.8", "--ao-only", camera=variant)["AO"]
+                except subprocess.CalledProcessError:
+                    cli = None
+                with warnings.catch_warnings():
+                    warnings.simplefilter("ignore")
+                    try:
+                        ao = ssao.ambient_occlusion(depth, normals=normals, camera=variant,
+                                                    radius=0.8)
+                    except ssao.SSAOError:
+                        ao = None
+                self.assertEqual(ao is None, cli is None,
+                                 f"CLI {'refuses' if cli is None else 'accepts'} it, the module "
+                                 f"{'refuses' if ao is None else 'accepts'} it")
+                if ao is not None and cli is not None:
+                    AgainstCli.assert_same_bits(self, ao, cli)
+                verdicts[ao is None] += 1
+        self.assertGreater(verdicts[False], 3)  # both kinds occur
+        self.assertGreater(verdicts[True], 20)
 
 
 class OtherInputs(unittest.TestCase):
