@@ -9,9 +9,12 @@
 // code) and "raymarch" (brute-force depth-buffer ray march), and "image" (an AO image from a
 // file, such as Cycles' AO pass at fewer samples: scored, not timed). The score is the RMSE and
 // the mean signed error (method - truth) of the AO over the pixels whose depth is finite, > 0
-// and < 0.9 * clip_end, against the file's "<layer>.AO.R" channel (Cycles' AO pass). Several
-// methods are timed in interleaved rounds (A B A B ...), so that their ratios share the
-// machine's moods. Run with --help for the options. Exit status: 0 success, 1 a failed check
+// and < 0.9 * clip_end, against the file's "<layer>.AO.R" channel (Cycles' AO pass), plus two
+// figures of where the error lies: "band", the RMSE of the difference of the band-passes
+// G(1) - G(6) of the two images (fine detail: contact shadows, creases, noise) and "edge_rmse",
+// the RMSE at depth discontinuities (see kUsage for their masks). Several methods are timed in
+// interleaved rounds (A B A B ...), so that their ratios share the machine's moods. Run with --help
+// for the options. Exit status: 0 success, 1 a failed check
 // (--max-rmse, --compare-to) or an unreadable input, 2 a command-line mistake.
 #include <algorithm>
 #include <array>
@@ -59,12 +62,23 @@ const char* const kUsage =
     "EXR with Depth (and optionally Normal) passes. Prints one line per method:\n"
     "  scene=... method=... settings=... normals=pass|depth rmse=... mean_error=... time_ms=...\n"
     "  min_ms=... repeat=N threads=T pixels=P rmse_interior=... interior_pixels=P\n"
-    "over the pixels whose depth is finite, > 0 and < 0.9 * clip_end. mean_error is the mean\n"
-    "of (method - truth): positive means too little occlusion. time_ms is the median of\n"
-    "--repeat runs of the AO computation alone (no file I/O), min_ms the fastest; the methods\n"
-    "run in interleaved rounds (A B C A B C ...) after one untimed round. An image method is\n"
-    "not timed (nan). rmse_interior leaves out the pixels beside one outside that set: on a\n"
-    "silhouette against the sky Cycles' pass reads coverage x AO (sky samples add nothing).\n"
+    "  band=... edge_rmse=...\n"
+    "over the pixels whose depth is finite, > 0 and < 0.9 * clip_end (the geometry pixels).\n"
+    "mean_error is the mean of (method - truth): positive means too little occlusion. time_ms\n"
+    "is the median of --repeat runs of the AO computation alone (no file I/O), min_ms the\n"
+    "fastest; the methods run in interleaved rounds (A B C A B C ...) after one untimed round.\n"
+    "An image method is not timed (nan). rmse_interior leaves out the pixels beside one outside\n"
+    "that set: on a silhouette against the sky Cycles' pass reads coverage x AO (sky samples\n"
+    "add nothing).\n"
+    "band: the RMSE of the difference of the band-passes G(1) - G(6) of the method's AO and\n"
+    "the truth (G(s): Gaussian blur of sigma s px, separable, truncated at 3 sigma,\n"
+    "clamp-to-edge; every pixel outside the geometry set at AO 1 in both images), over the\n"
+    "geometry pixels whose whole 7x7 square (the pixels within 3 px, Chebyshev distance)\n"
+    "inside the frame is geometry: the fine-scale error (contact shadows, creases, noise)\n"
+    "without the large-scale bias. edge_rmse: the RMSE over the geometry pixels with a depth\n"
+    "jump to a 4-neighbour that is geometry too, |d - d_n| > 0.05 * min(d, d_n) (edges\n"
+    "against the sky do not count). Either is nan when it has no pixel. With region=, the\n"
+    "pixels outside the region count as outside the geometry.\n"
     "\n"
     "Methods:\n"
     "  ssao             libssao through its C API; world-space normals from the Normal pass\n"
@@ -793,7 +807,123 @@ struct Score {
   size_t pixels = 0;
   double rmse_interior = 0.0;  // over the scored pixels none of whose 8 neighbours is unscored
   size_t interior_pixels = 0;
+  double band = 0.0;       // RMSE of the difference of the band-passes G(1) - G(6)
+  double edge_rmse = 0.0;  // RMSE at depth discontinuities
 };
+
+// The band-pass G(1) - G(6): sigmas in pixels, each Gaussian separable, truncated at 3 sigma and
+// normalised, with clamp-to-edge.
+constexpr double kBandFine = 1.0, kBandCoarse = 6.0;
+constexpr int kBandErosion = 3;          // the band's pixels: geometry within 3 px (7x7 square)
+constexpr double kEdgeDepthJump = 0.05;  // an edge: |d - d_n| > 5 % of the nearer depth
+
+// `image` (w x h) blurred by a Gaussian of `sigma` pixels (see kBandFine).
+std::vector<double> gaussian_blur(const std::vector<double>& image, int w, int h, double sigma) {
+  const int radius = static_cast<int>(std::ceil(3.0 * sigma));
+  std::vector<double> kernel(size_t(2 * radius + 1));
+  double total = 0.0;
+  for (int i = -radius; i <= radius; ++i) {
+    total += kernel[size_t(i + radius)] = std::exp(-0.5 * double(i * i) / (sigma * sigma));
+  }
+  for (double& k : kernel) k /= total;
+  std::vector<double> rows(image.size()), out(image.size());
+  for (int y = 0; y < h; ++y) {
+    const double* line = image.data() + size_t(y) * size_t(w);
+    for (int x = 0; x < w; ++x) {
+      double sum = 0.0;
+      for (int i = -radius; i <= radius; ++i) {
+        sum += kernel[size_t(i + radius)] * line[std::clamp(x + i, 0, w - 1)];
+      }
+      rows[size_t(y) * size_t(w) + size_t(x)] = sum;
+    }
+  }
+  for (int y = 0; y < h; ++y) {
+    for (int x = 0; x < w; ++x) {
+      double sum = 0.0;
+      for (int i = -radius; i <= radius; ++i) {
+        sum += kernel[size_t(i + radius)] *
+               rows[size_t(std::clamp(y + i, 0, h - 1)) * size_t(w) + size_t(x)];
+      }
+      out[size_t(y) * size_t(w) + size_t(x)] = sum;
+    }
+  }
+  return out;
+}
+
+// `set` (w x h, 0 or 1) eroded by the (2 r + 1)^2 square: 1 where every pixel of the square that
+// lies inside the frame is 1 (separable: the minimum along rows, then along columns).
+std::vector<unsigned char> erode(const std::vector<unsigned char>& set, int w, int h, int r) {
+  std::vector<unsigned char> rows(set.size()), out(set.size());
+  for (int y = 0; y < h; ++y) {
+    for (int x = 0; x < w; ++x) {
+      unsigned char all = 1;
+      for (int nx = std::max(x - r, 0); nx <= std::min(x + r, w - 1) && all; ++nx) {
+        all = set[size_t(y) * size_t(w) + size_t(nx)];
+      }
+      rows[size_t(y) * size_t(w) + size_t(x)] = all;
+    }
+  }
+  for (int y = 0; y < h; ++y) {
+    for (int x = 0; x < w; ++x) {
+      unsigned char all = 1;
+      for (int ny = std::max(y - r, 0); ny <= std::min(y + r, h - 1) && all; ++ny) {
+        all = rows[size_t(ny) * size_t(w) + size_t(x)];
+      }
+      out[size_t(y) * size_t(w) + size_t(x)] = all;
+    }
+  }
+  return out;
+}
+
+// Whether the scored pixel p = (x, y) has a depth jump of more than kEdgeDepthJump to a
+// 4-neighbour that shows geometry (an edge against the sky is not one).
+bool depth_edge(const Scene& s, int x, int y) {
+  const size_t p = size_t(y) * size_t(s.width) + size_t(x);
+  const double d = s.depth[p];
+  const int dx[4] = {-1, 1, 0, 0}, dy[4] = {0, 0, -1, 1};
+  for (int i = 0; i < 4; ++i) {
+    const int nx = x + dx[i], ny = y + dy[i];
+    if (nx < 0 || ny < 0 || nx >= s.width || ny >= s.height) continue;
+    const size_t n = size_t(ny) * size_t(s.width) + size_t(nx);
+    if (!s.mask[n]) continue;
+    const double dn = s.depth[n];
+    if (std::fabs(d - dn) > kEdgeDepthJump * std::min(d, dn)) return true;
+  }
+  return false;
+}
+
+// band and edge_rmse of `ao` against the scene's truth over `scored` (the geometry pixels in the
+// method's window). Outside `scored` both images read AO 1 (Cycles' pass reads 0 in the sky):
+// the band-pass is linear, so the band-passes' difference is the band-pass of the difference,
+// which is 0 there.
+void score_detail(const Scene& s, const std::vector<float>& ao,
+                  const std::vector<unsigned char>& scored, Score& sc) {
+  const int w = s.width, h = s.height;
+  std::vector<double> diff(scored.size(), 0.0);
+  for (size_t p = 0; p < scored.size(); ++p) {
+    if (scored[p]) diff[p] = static_cast<double>(ao[p]) - static_cast<double>(s.truth[p]);
+  }
+  const std::vector<double> fine = gaussian_blur(diff, w, h, kBandFine);
+  const std::vector<double> coarse = gaussian_blur(diff, w, h, kBandCoarse);
+  const std::vector<unsigned char> inner = erode(scored, w, h, kBandErosion);
+  double band_sq = 0.0, edge_sq = 0.0;
+  size_t band_pixels = 0, edge_pixels = 0;
+  for (int y = 0; y < h; ++y) {
+    for (int x = 0; x < w; ++x) {
+      const size_t p = size_t(y) * size_t(w) + size_t(x);
+      if (!scored[p]) continue;
+      if (inner[p]) {
+        const double b = fine[p] - coarse[p];
+        band_sq += b * b;
+        ++band_pixels;
+      }
+      if (depth_edge(s, x, y)) edge_sq += diff[p] * diff[p], ++edge_pixels;
+    }
+  }
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  sc.band = band_pixels > 0 ? std::sqrt(band_sq / double(band_pixels)) : nan;
+  sc.edge_rmse = edge_pixels > 0 ? std::sqrt(edge_sq / double(edge_pixels)) : nan;
+}
 
 // Whether every pixel around (x, y) inside the image is scored.
 bool interior(const Scene& s, int x, int y) {
@@ -813,10 +943,12 @@ Score score(const Scene& s, const Method& m) {
   }
   Score sc;
   double sum = 0.0, sum_sq = 0.0, interior_sq = 0.0;
+  std::vector<unsigned char> scored(s.mask.size(), 0);
   for (int y = std::max(0, m.window.y0); y < std::min(s.height, m.window.y1); ++y) {
     for (int x = std::max(0, m.window.x0); x < std::min(s.width, m.window.x1); ++x) {
       const size_t p = static_cast<size_t>(y) * static_cast<size_t>(s.width) + x;
       if (!s.mask[p]) continue;
+      scored[p] = 1;
       const double diff = static_cast<double>(ao[p]) - static_cast<double>(s.truth[p]);
       sum += diff;
       sum_sq += diff * diff;
@@ -831,6 +963,7 @@ Score score(const Scene& s, const Method& m) {
   const double n = static_cast<double>(sc.pixels);
   sc.rmse = std::sqrt(sum_sq / n);
   sc.mean_error = sum / n;
+  score_detail(s, ao, scored, sc);
   return sc;
 }
 
@@ -841,10 +974,10 @@ Score report(const Scene& s, const Options& o, const Method& m, const std::vecto
   std::printf(
       "scene=%s method=%s settings=%s normals=%s rmse=%.5f mean_error=%+.5f "
       "time_ms=%.2f min_ms=%.2f repeat=%d threads=%d pixels=%zu rmse_interior=%.5f "
-      "interior_pixels=%zu\n",
+      "interior_pixels=%zu band=%.5f edge_rmse=%.5f\n",
       s.name.c_str(), m.name.c_str(), m.settings.c_str(), s.world_normal.empty() ? "depth" : "pass",
       sc.rmse, sc.mean_error, median(ms), min_ms, o.repeat, m.threads, sc.pixels, sc.rmse_interior,
-      sc.interior_pixels);
+      sc.interior_pixels, sc.band, sc.edge_rmse);
   std::fflush(stdout);
   return sc;
 }
