@@ -35,6 +35,7 @@
 #include <string>
 #include <system_error>
 #include <thread>
+#include <utility>
 #include <vector>
 
 #include "camera.h"  // core/src (through ssao_reference): the camera model of the references
@@ -114,7 +115,10 @@ const char* const kUsage =
     "  --layers FILE        the scene's extra depth layers and guard band, as\n"
     "                       scripts/blender/render_layers.py writes them (same camera, pixel\n"
     "                       grid and seed); method ssao then takes layers=N (extra hits to\n"
-    "                       use, default 0) and band=G (guard band pixels, default 0)\n"
+    "                       use, default 0) and band=G (guard band pixels, default 0). As\n"
+    "                       the Blender add-on does, a hit not behind the depth the library\n"
+    "                       is given (the scene's in the frame) is dropped and the later\n"
+    "                       ones move up; stderr says at how many pixels\n"
     "  --no-normals         ignore the Normal pass: every method reconstructs normals from depth\n"
     "  -h, --help           show this help\n"
     "\n"
@@ -339,6 +343,63 @@ struct Scene {
   std::vector<std::vector<float>> layer_depth, layer_facing;
 };
 
+// Blender's depth where a ray hits nothing (the layers file's "no hit").
+constexpr float kNoHit = 1e10f;
+
+// Whether the library takes `depth` for a surface: its default background rule (finite, > 0,
+// below background_depth 1e9 and clip_end; docs/conventions.md, "Depth").
+bool is_surface(float depth, double clip_end) {
+  return std::isfinite(depth) && depth > 0.0f && depth < 1e9f &&
+         (clip_end <= 0.0 || static_cast<double>(depth) < clip_end);
+}
+
+// The extra hits of the layers file as the Blender add-on gives them to the library
+// (blender_addon/compute.py, _extra_layers): behind the depth the library is given (the scene's
+// in the frame, the layers file's in the band). The helper render's first hit can differ from
+// the reference's depth (on a silhouette its one sample need not be the reference's), so a hit
+// not strictly behind that depth is dropped and the later ones move up, in depth order; the
+// empty places are "no hit" (facing 0). Prints on stderr at how many surface pixels a hit moved
+// or went.
+void drop_hits_not_behind(const Options& o, Scene& s) {
+  const size_t layers = s.layer_depth.size();
+  if (layers == 0) return;
+  const int band = s.band, grid_width = s.width + 2 * band, grid_height = s.height + 2 * band;
+  std::vector<std::pair<float, float>> hits;  // (depth, facing) of one pixel
+  size_t in_frame = 0, in_band = 0;
+  for (int y = 0; y < grid_height; ++y) {
+    for (int x = 0; x < grid_width; ++x) {
+      const size_t p = size_t(y) * size_t(grid_width) + size_t(x);
+      const int fx = x - band, fy = y - band;
+      const bool inside = fx >= 0 && fy >= 0 && fx < s.width && fy < s.height;
+      const float depth =
+          inside ? s.depth[size_t(fy) * size_t(s.width) + size_t(fx)] : s.band_depth[p];
+      hits.clear();
+      for (size_t k = 0; k < layers; ++k) {
+        const float d = s.layer_depth[k][p];
+        if (d > depth) {  // false for NaN
+          hits.emplace_back(d, s.layer_facing[k].empty() ? 0.0f : s.layer_facing[k][p]);
+        }
+      }
+      std::stable_sort(hits.begin(), hits.end(),
+                       [](const auto& a, const auto& b) { return a.first < b.first; });
+      bool changed = false;
+      for (size_t k = 0; k < layers; ++k) {
+        const std::pair<float, float> hit =
+            k < hits.size() ? hits[k] : std::make_pair(kNoHit, 0.0f);
+        // NaN compares unequal: a NaN hit (dropped) counts as a change.
+        changed = changed || !(s.layer_depth[k][p] == hit.first);
+        s.layer_depth[k][p] = hit.first;
+        if (!s.layer_facing[k].empty()) s.layer_facing[k][p] = hit.second;
+      }
+      if (changed && is_surface(depth, s.camera.clip_end)) ++(inside ? in_frame : in_band);
+    }
+  }
+  std::fprintf(stderr,
+               "%s: --layers '%s': hits not behind the depth dropped (the later ones moved up, "
+               "as the Blender add-on does) at %zu pixel(s): %zu in the frame, %zu in the band\n",
+               kProgram, o.layers_file.c_str(), in_frame + in_band, in_frame, in_band);
+}
+
 // Reads --layers FILE into the scene: a data window grown by the same band on every side.
 void load_layers(const Options& o, Scene& s) {
   ssao_tools::Image image = ssao_tools::read_image(o.layers_file, ssao_tools::Overscan::read);
@@ -365,6 +426,7 @@ void load_layers(const Options& o, Scene& s) {
     s.layer_depth.push_back(channel(layer.depth));
     s.layer_facing.push_back(layer.facing.empty() ? std::vector<float>() : channel(layer.facing));
   }
+  drop_hits_not_behind(o, s);
 }
 
 Scene load_scene(const Options& o) {
