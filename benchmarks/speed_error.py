@@ -42,7 +42,8 @@ LAYERS_SOURCES = KIT_SCRIPTS + [LAYERS_SCRIPT, os.path.join(BLENDER_SCRIPTS, "re
     os.path.join(REPO_ROOT, "blender_addon", name)
     for name in ("hidden_surfaces.py", "multilayer.py", "compat.py")]
 GUARD_BAND = 64
-CSV_COLUMNS = ["scene", "method", "setting", "threads", "time_s", "rmse", "bias"]
+CSV_COLUMNS = ["scene", "method", "setting", "threads", "time_s", "rmse", "bias", "band",
+               "edge_rmse"]
 
 SD, HD = (640, 360), (1920, 1080)
 CYCLES_SAMPLES = [1, 2, 4, 8, 16, 64]
@@ -276,6 +277,8 @@ def run_eval(args, reference, runs, repeat, what, layers=None):
     if proc.returncode != 0 or len(results) != len(runs):
         raise StepFailed("ssao_eval failed on %s (exit %d): %s\n%s%s"
                          % (what, proc.returncode, " ".join(command), proc.stdout, proc.stderr))
+    for line in proc.stderr.splitlines():  # warnings, and with --layers the hits it dropped
+        log("%s: %s" % (what, line))
     return results
 
 
@@ -306,9 +309,10 @@ def measure_scene(args, plan, reference, scene, size, sweeps, layers=None):
     except StepFailed as error:
         if not layers:
             raise
-        # A layers file the library refuses (a hit nearer than the reference's depth: the
-        # helper render's first hit can differ from the reference's sample 0 on a silhouette)
-        # costs the layer rows only, not the scene.
+        # A layers file that ssao_eval or the library refuses costs the layer rows only, not
+        # the scene. (A hit nearer than the reference's depth on a silhouette, where the helper
+        # render's first hit differs from the reference's sample 0, is no longer one: ssao_eval
+        # drops it as the add-on does. A file of another frame or grid still is.)
         log("layers refused on %s, measured without the layer rows: %s"
             % (label(scene, size), str(error).splitlines()[-1]))
         entries = [entry for entry in entries
@@ -321,7 +325,8 @@ def measure_scene(args, plan, reference, scene, size, sweeps, layers=None):
         row = {"scene": label(scene, size), "time_s": float(result["time_ms"]) / 1000.0,
                "threads": int(result["threads"])}
         row.update(known)
-        row.update(rmse=float(result["rmse"]), bias=float(result["mean_error"]))
+        row.update(rmse=float(result["rmse"]), bias=float(result["mean_error"]),
+                   band=float(result["band"]), edge_rmse=float(result["edge_rmse"]))
         rows.append(row)
     return rows
 
@@ -379,6 +384,7 @@ def speedups(rows):
             continue
         t_cycles, relation = cycles_time_to(ours[0]["rmse"], cycles)
         out.append({"scene": scene, "time_s": ours[0]["time_s"], "rmse": ours[0]["rmse"],
+                    "band": ours[0]["band"], "edge_rmse": ours[0]["edge_rmse"],
                     "cycles_s": t_cycles, "relation": relation,
                     "speedup": t_cycles / ours[0]["time_s"]})
     return out
@@ -518,10 +524,10 @@ def speedup_table(table):
             relation = "" if s["relation"] == "=" else s["relation"] + " "
             cycles = "%s%.2f s" % (relation, s["cycles_s"])
             speedup = "%s%.1fx" % (relation, s["speedup"])
-        lines.append([s["scene"], "%.1f ms" % (1000 * s["time_s"]), "%.4f" % s["rmse"], cycles,
-                      speedup])
-    return markdown_table(["scene", "libssao default", "RMSE", "Cycles to the same RMSE",
-                           "speed-up"], lines)
+        lines.append([s["scene"], "%.1f ms" % (1000 * s["time_s"]), "%.4f" % s["rmse"],
+                      "%.4f" % s["band"], "%.4f" % s["edge_rmse"], cycles, speedup])
+    return markdown_table(["scene", "libssao default", "RMSE", "band", "edge RMSE",
+                           "Cycles to the same RMSE", "speed-up"], lines)
 
 
 def ground_truth(plan):
@@ -538,10 +544,18 @@ def rmse_by_size(rows):
     return by_size
 
 
+def error_cell(values, bold=False):
+    """"RMSE / band / edge RMSE" of (rmse, band, edge_rmse), as one table cell."""
+    text = " / ".join("%.4f" % v for v in values)
+    return "**%s**" % text if bold else text
+
+
 def layers_table(rows):
-    """Per scene: the default's RMSE alone, with the extra depth layers, with the guard band and
-    with both, and the time with layers over the default's; then the means."""
+    """Per scene: the default's RMSE / band / edge RMSE alone, with the extra depth layers, with
+    the guard band and with both, and the time with layers over the default's; then the
+    means."""
     settings = ["default"] + [setting for _, setting, _ in LAYER_ROWS]
+    measures = ("rmse", "band", "edge_rmse")
     lines, means = [], {s: [] for s in settings}
     for scene in dict.fromkeys(r["scene"] for r in rows):
         found = {r["setting"]: r for r in rows
@@ -549,12 +563,13 @@ def layers_table(rows):
         if len(found) != len(settings):
             continue
         for s in settings:
-            means[s].append(found[s]["rmse"])
-        lines.append([scene] + ["%.4f" % found[s]["rmse"] for s in settings] +
+            means[s].append([found[s][m] for m in measures])
+        lines.append([scene] + [error_cell(found[s][m] for m in measures) for s in settings] +
                      ["%.2fx" % (found[LAYER_ROWS[0][1]]["time_s"] / found["default"]["time_s"])])
     if not lines:
         return "(no scene has its layers file)"
-    lines.append(["**mean**"] + ["**%.4f**" % statistics.mean(means[s]) for s in settings] + [""])
+    lines.append(["**mean**"] + [error_cell((statistics.mean(column) for column in zip(*means[s])),
+                                            bold=True) for s in settings] + [""])
     return markdown_table(["scene", "one layer (default)", "+ 2nd, 3rd hits",
                            "+ %d px band" % GUARD_BAND, "+ both", "time with layers"], lines)
 
@@ -582,6 +597,8 @@ def write_markdown(path, images, args, plan, rows, table, complexity, noise, mac
         "`samples=N` is its AO pass rendered the fastest correct way at N samples per pixel."
         % (plan.repeat, args.threads, args.threads),
         "",
+        MEASURES_NOTE,
+        "",
         "## Equal-error speed-up over Cycles' AO pass",
         "",
         "The time Cycles needs to reach our default's RMSE (interpolated, log time against "
@@ -598,8 +615,12 @@ def write_markdown(path, images, args, plan, rows, table, complexity, noise, mac
         "each pixel's ray with their facing (`depth2`, `depth3`, `facing2`, `facing3`) and a "
         "%d-pixel guard band around the frame (overscan), rendered by the add-on's helper render "
         "(`scripts/blender/benchmark_layers.py`: Cycles, 1 sample per pixel) on the reference's "
-        "pixel grid. RMSE against the same reference as above; the time ratio is the AO "
-        "computation with 2 extra layers over the default's, the same run." % GUARD_BAND,
+        "pixel grid; as the add-on does, a hit not behind the reference's depth (on a "
+        "silhouette the helper's one sample can see the nearer surface) is dropped and the "
+        "later ones move up. Each cell: RMSE / band / edge RMSE against the same reference as "
+        "above; "
+        "the time ratio is the AO computation with 2 extra layers over the default's, the same "
+        "run." % GUARD_BAND,
         "",
         layers_table(rows),
         "",
@@ -618,11 +639,13 @@ def write_markdown(path, images, args, plan, rows, table, complexity, noise, mac
         "",
         "The same figures as `speed_error.csv` (columns %s)." % ", ".join(CSV_COLUMNS),
         "",
-        markdown_table(["scene", "method", "setting", "threads", "time (ms)", "RMSE", "bias"],
+        markdown_table(["scene", "method", "setting", "threads", "time (ms)", "RMSE", "bias",
+                        "band", "edge RMSE"],
                        [[r["scene"], r["method"],
                          "**default**" if r["setting"] == "default" else r["setting"],
                          r["threads"], "%.1f" % (1000 * r["time_s"]), "%.4f" % r["rmse"],
-                         "%+.4f" % r["bias"]] for r in rows]),
+                         "%+.4f" % r["bias"], "%.4f" % r["band"], "%.4f" % r["edge_rmse"]]
+                        for r in rows]),
         "",
         "Mean RMSE of the default: %s." % "; ".join(
             "%.4f over the %d scene(s) at %s" % (statistics.mean(errors), len(errors), size)
@@ -644,6 +667,20 @@ def write_markdown(path, images, args, plan, rows, table, complexity, noise, mac
 
 
 KEPT_MARKER = "<!-- Below: measured by other benchmarks; speed_error.py keeps it as it is. -->"
+
+# What band and edge RMSE are (ssao_eval --help says the same).
+MEASURES_NOTE = (
+    "band and edge RMSE say where the error lies, over the same geometry pixels and against the "
+    "same reference. band is the RMSE of the difference of the band-passes G(1) - G(6) of the two "
+    "images (G(s): a Gaussian blur of sigma s pixels, separable, truncated at 3 sigma, clamp-to-"
+    "edge; every pixel that is not geometry set to AO 1 in both images, where Cycles writes 0 in "
+    "the sky), over the geometry pixels whose whole 7x7 square (every pixel within 3 px, inside "
+    "the frame) is geometry: the error at the scale of contact shadows and creases, without the "
+    "large-scale bias that dominates the RMSE (G(1) also smooths away most per-pixel noise: white "
+    "noise keeps about a quarter of its RMS). edge RMSE is the RMSE over the geometry pixels with "
+    "a depth jump of more than 5 % to a 4-neighbour that is geometry too (|d - d_n| > 0.05 x "
+    "min(d, d_n); edges against the sky do not count): the silhouettes, where a depth buffer does "
+    "not say what lies behind. Both are 0 for the reference scored against itself.")
 
 
 METHOD_NOTES = """## How it is measured

@@ -9,6 +9,7 @@ made-up curves.
 """
 import argparse
 import csv
+import glob
 import math
 import os
 import subprocess
@@ -63,7 +64,8 @@ class QuickRunTest(unittest.TestCase):
                 self.assertEqual(f.read(8), b"\x89PNG\r\n\x1a\n", name)
 
     def test_csv_columns_and_values(self):
-        self.assertEqual(self.header, "scene,method,setting,threads,time_s,rmse,bias")
+        self.assertEqual(self.header,
+                         "scene,method,setting,threads,time_s,rmse,bias,band,edge_rmse")
         self.assertGreater(len(self.rows), 20)
         for r in self.rows:
             self.assertNotIn(None, r.values(), r)
@@ -72,6 +74,28 @@ class QuickRunTest(unittest.TestCase):
             self.assertTrue(0.0 <= float(r["rmse"]) <= 1.0, r)
             self.assertTrue(-1.0 <= float(r["bias"]) <= 1.0, r)
             self.assertLessEqual(abs(float(r["bias"])), float(r["rmse"]) + 1e-6, r)
+            # Finite (a comparison with nan is false), >= 0, and no method matches the
+            # reference exactly.
+            self.assertTrue(0.0 < float(r["band"]) <= 1.0, r)
+            self.assertTrue(0.0 < float(r["edge_rmse"]) <= 1.0, r)
+
+    def test_band_of_noise_is_below_its_rmse(self):
+        # Cycles at 1 spp is mostly per-pixel noise, which G(1) smooths away (white noise keeps
+        # about 0.27 of its RMS in G(1) - G(6)): its band must lie well below its RMSE. A band
+        # computed without the blur, or of the wrong images, would not.
+        for scene in SCENES:
+            (one,) = [r for r in self.rows_of(scene, "cycles") if r["setting"] == "samples=1"]
+            self.assertLess(float(one["band"]), 0.6 * float(one["rmse"]), one)
+
+    def test_reference_against_itself_scores_zero(self):
+        # The reference's AO pass scored as the method: every figure 0, through run_eval's
+        # parsing as the benchmark reads it.
+        (reference,) = glob.glob(os.path.join(self.kit, "contact@%s-*s1-*" % SIZE, "ref.exr"))
+        args = argparse.Namespace(eval=os.path.join(OPTIONS["build_dir"], "bin", "ssao_eval"))
+        (result,) = speed_error.run_eval(args, reference[:-len(".exr")],
+                                         [("image", ["path=" + reference])], 1, "self")
+        for field in ("rmse", "band", "edge_rmse"):
+            self.assertEqual(float(result[field]), 0.0, result)
 
     def test_every_scene_has_every_method(self):
         scenes = {r["scene"] for r in self.rows}
@@ -94,6 +118,9 @@ class QuickRunTest(unittest.TestCase):
             self.assertLess(float(by_samples[64]["rmse"]), 0.5 * float(by_samples[1]["rmse"]),
                             scene)
             self.assertLess(abs(float(by_samples[64]["bias"])), 0.02, scene)
+            for figure in ("band", "edge_rmse"):
+                self.assertLess(float(by_samples[64][figure]), 0.5 * float(by_samples[1][figure]),
+                                (scene, figure))
 
     def test_complexity_grows_by_four_per_level(self):
         triangles = {}
@@ -114,6 +141,8 @@ class QuickRunTest(unittest.TestCase):
         self.assertIn("(speed_error.png)", text)
         self.assertIn("(complexity.png)", text)
         self.assertIn("Equal-error speed-up over Cycles' AO pass", self.proc.stdout)
+        self.assertIn("| RMSE | band | edge RMSE |", text)  # the speed-up table's header
+        self.assertIn("| RMSE | bias | band | edge RMSE |", text)  # every row's
         for scene in SCENES:
             self.assertIn("| %s |" % scene, text)
             self.assertRegex(self.proc.stdout, r"\| %s \| [0-9.]+ ms \| 0\.\d{4} \|" % scene)
@@ -164,7 +193,7 @@ class SpeedupTest(unittest.TestCase):
     def test_csv_quotes_settings_with_commas(self):
         path = os.path.join(OPTIONS["scratch"], "quoted.csv")
         rows = [{"scene": "s@64x36", "method": "hemisphere", "setting": label, "threads": 2,
-                 "time_s": 0.5, "rmse": 0.05, "bias": -0.01}
+                 "time_s": 0.5, "rmse": 0.05, "bias": -0.01, "band": 0.02, "edge_rmse": 0.1}
                 for _, label, _ in speed_error.LIBRARY_FULL]
         speed_error.write_csv(path, speed_error.CSV_COLUMNS, rows)
         with open(path, encoding="utf-8", newline="") as f:
@@ -180,7 +209,7 @@ class SpeedupTest(unittest.TestCase):
     def test_speedups_per_scene(self):
         rows = [dict(r, scene="s", method="cycles", setting="samples=1") for r in self.CYCLES]
         rows.append({"scene": "s", "method": "hemisphere", "setting": "default",
-                     "time_s": 0.02, "rmse": 0.2})
+                     "time_s": 0.02, "rmse": 0.2, "band": 0.05, "edge_rmse": 0.3})
         (result,) = speed_error.speedups(rows)
         self.assertAlmostEqual(result["speedup"], 100.0)
         self.assertEqual(result["relation"], "=")
