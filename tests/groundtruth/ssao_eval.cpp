@@ -11,7 +11,7 @@
 // the mean signed error (method - truth) of the AO over the pixels whose depth is finite, > 0
 // and < 0.9 * clip_end, against the file's "<layer>.AO.R" channel (Cycles' AO pass), plus two
 // figures of where the error lies: "band", the RMSE of the difference of the band-passes
-// G(1) - G(6) of the two images (fine detail: contact shadows, creases, noise) and "edge_rmse",
+// G(1) - G(6) of the two images (detail of 1 to 6 px: contact shadows, creases) and "edge_rmse",
 // the RMSE at depth discontinuities (see kUsage for their masks). Several methods are timed in
 // interleaved rounds (A B A B ...), so that their ratios share the machine's moods. Run with --help
 // for the options. Exit status: 0 success, 1 a failed check
@@ -75,8 +75,9 @@ const char* const kUsage =
     "the truth (G(s): Gaussian blur of sigma s px, separable, truncated at 3 sigma,\n"
     "clamp-to-edge; every pixel outside the geometry set at AO 1 in both images), over the\n"
     "geometry pixels whose whole 7x7 square (the pixels within 3 px, Chebyshev distance)\n"
-    "inside the frame is geometry: the fine-scale error (contact shadows, creases, noise)\n"
-    "without the large-scale bias. edge_rmse: the RMSE over the geometry pixels with a depth\n"
+    "inside the frame is geometry: the error at the scale of contact shadows and creases,\n"
+    "without the large-scale bias (G(1) smooths away most per-pixel noise: white noise keeps\n"
+    "0.27 of its RMS). edge_rmse: the RMSE over the geometry pixels with a depth\n"
     "jump to a 4-neighbour that is geometry too, |d - d_n| > 0.05 * min(d, d_n) (edges\n"
     "against the sky do not count). Either is nan when it has no pixel. With region=, the\n"
     "pixels outside the region count as outside the geometry.\n"
