@@ -37,7 +37,7 @@ struct HemisphereRowArgs {
   int extra_layers;
   int width, height;
   CameraIntrinsics camera;
-  float radius, min_height_bias, thickness;
+  float radius, min_height_bias, thickness, crossing_tolerance;
   size_t plane;  // floats per layer plane
   int directions, steps;
   // Per row class (y & 3), per sample, x/y/z of the tangent-frame offset for kLaneTable lanes
@@ -52,8 +52,86 @@ namespace ssao {
 namespace HWY_NAMESPACE {
 namespace hn = hwy::HWY_NAMESPACE;
 
-// Visibility of pixels [x0, x1) of row y into out[0 .. x1 - x0).
-void hemisphere_row(const HemisphereRowArgs& a, int y, int x0, int x1, float* out) {
+// The pixel (qx, qy) that view-space points (x, y, z) project to, on the lanes where they fall
+// inside the image in front of the camera (pixel_of_sample in variant.h).
+template <class VF, class VI>
+HWY_INLINE auto project_to_pixel(const CameraIntrinsics& cam, int width, int height, VF x, VF y,
+                                 VF z, VI& qx, VI& qy) {
+  namespace hn = hwy::HWY_NAMESPACE;
+  const hn::DFromV<VF> df;
+  const hn::RebindToSigned<decltype(df)> di;
+  const VF zero = hn::Zero(df), one = hn::Set(df, 1.0f);
+  const VF center_u = hn::Set(df, cam.center_u), center_v = hn::Set(df, cam.center_v);
+  const VF inv_scale_u = hn::Set(df, 1.0f / cam.scale_u),
+           inv_scale_v = hn::Set(df, 1.0f / cam.scale_v);
+  VF u, v;
+  auto in_image = hn::Gt(hn::Neg(z), zero);
+  if (cam.orthographic) {
+    u = hn::MulAdd(x, inv_scale_u, center_u);
+    v = hn::NegMulAdd(y, inv_scale_v, center_v);
+    in_image = hn::Lt(zero, one);  // all true
+  } else {
+    // 1 / depth: the hardware estimate refined by one Newton step (relative error below
+    // 1e-7, as a division's, at a fraction of its cost).
+    const VF depth = hn::Neg(z);
+    const VF estimate = hn::ApproximateReciprocal(depth);
+    const VF inv = estimate * hn::NegMulAdd(depth, estimate, hn::Set(df, 2.0f));
+    u = hn::MulAdd(x * inv, inv_scale_u, center_u);
+    v = hn::NegMulAdd(y * inv, inv_scale_v, center_v);
+  }
+  in_image = hn::And(in_image,
+                     hn::And(hn::And(hn::Ge(u, zero), hn::Ge(v, zero)),
+                             hn::And(hn::Lt(u, hn::Set(df, float(width))),
+                                     hn::Lt(v, hn::Set(df, float(height))))));
+  qx = hn::ConvertTo(di, hn::IfThenElseZero(in_image, u));
+  qy = hn::ConvertTo(di, hn::IfThenElseZero(in_image, v));
+  return in_image;
+}
+
+// Hemisphere::crossing on the lanes of `candidate`, whose points a and b lie on either side of
+// the plane dot(x, c) = w: 1 where the depth image shows the plane, or something in front of
+// it, at the point where the segment meets the plane.
+template <class M, class VF>
+HWY_INLINE VF crossing_lanes(const HemisphereRowArgs& a, M candidate, VF ax, VF ay, VF az, VF bx,
+                             VF by, VF bz, VF cx, VF cy, VF cz, VF w) {
+  namespace hn = hwy::HWY_NAMESPACE;
+  const hn::DFromV<VF> df;
+  const hn::RebindToSigned<decltype(df)> di;
+  const CameraIntrinsics& cam = a.camera;
+  const VF zero = hn::Zero(df), one = hn::Set(df, 1.0f);
+  const VF side_a = hn::MulAdd(ax, cx, hn::MulAdd(ay, cy, az * cz)) - w;
+  const VF side_b = hn::MulAdd(bx, cx, hn::MulAdd(by, cy, bz * cz)) - w;
+  const VF t = side_a / hn::IfThenElse(candidate, side_a - side_b, one);
+  const VF px = hn::MulAdd(bx - ax, t, ax), py = hn::MulAdd(by - ay, t, ay),
+           pz = hn::MulAdd(bz - az, t, az);
+  auto lanes = candidate;
+  hn::Vec<decltype(di)> qx, qy;
+  lanes = hn::And(lanes, project_to_pixel(cam, a.width, a.height, px, py, pz, qx, qy));
+  if (hn::AllFalse(df, lanes)) return zero;
+  // (qx, qy) are 0 on lanes outside the image: every index is in the plane.
+  const VF depth = hn::GatherIndex(df, a.depth, qy * hn::Set(di, a.width) + qx);
+  // The plane's depth on the ray through that pixel's centre: origin o + depth * direction r.
+  const VF u = (hn::ConvertTo(df, qx) + hn::Set(df, 0.5f) - hn::Set(df, cam.center_u)) *
+               hn::Set(df, cam.scale_u);
+  const VF v = (hn::Set(df, cam.center_v) - hn::ConvertTo(df, qy) - hn::Set(df, 0.5f)) *
+               hn::Set(df, cam.scale_v);
+  VF numerator = w, slope = hn::Neg(cz);  // orthographic: o = (u, v, 0), r = (0, 0, -1)
+  if (cam.orthographic) {
+    numerator = w - hn::MulAdd(u, cx, v * cy);
+  } else {  // o = 0, r = (u, v, -1)
+    slope = hn::MulAdd(u, cx, hn::MulSub(v, cy, cz));
+  }
+  lanes = hn::And(lanes, hn::Gt(hn::Abs(slope), hn::Set(df, 1e-6f)));
+  const VF plane_depth = numerator / hn::IfThenElse(lanes, slope, one);
+  const auto on_surface = hn::And(
+      lanes, hn::Le(depth, plane_depth + hn::Set(df, a.crossing_tolerance)));
+  return hn::IfThenElseZero(on_surface, one);
+}
+
+// Visibility of pixels [x0, x1) of row y into out[0 .. x1 - x0); kLayers: the frame has extra
+// depth layers (compiled apart, so that the one-layer loop carries none of their state).
+template <bool kLayers>
+HWY_INLINE void hemisphere_row_of(const HemisphereRowArgs& a, int y, int x0, int x1, float* out) {
   const hn::ScalableTag<float> df;
   const hn::RebindToSigned<decltype(df)> di;
   using VF = hn::Vec<decltype(df)>;
@@ -69,9 +147,6 @@ void hemisphere_row(const HemisphereRowArgs& a, int y, int x0, int x1, float* ou
   const VF pixel_v0 = hn::Set(df, (cam.center_v - 0.5f) * cam.scale_v);
   const VF scale_u = hn::Set(df, cam.scale_u), scale_v = hn::Set(df, cam.scale_v);
   const VF center_u = hn::Set(df, cam.center_u), center_v = hn::Set(df, cam.center_v);
-  const VF inv_scale_u = hn::Set(df, 1.0f / cam.scale_u),
-           inv_scale_v = hn::Set(df, 1.0f / cam.scale_v);
-  const VF width_f = hn::Set(df, float(a.width)), height_f = hn::Set(df, float(a.height));
   const VF inv_thickness = hn::Set(df, 1.0f / a.thickness);
   const VF radius = hn::Set(df, a.radius);
   // Vectors start at x0 + a multiple of `lanes` (itself a multiple of 4): one phase.
@@ -125,9 +200,16 @@ void hemisphere_row(const HemisphereRowArgs& a, int y, int x0, int x1, float* ou
     const VF plane_level = hn::MulAdd(px, nx, hn::MulAdd(py, ny, hn::MulAdd(pz, nz, min_height)));
     VF occlusion = zero, valid = zero;
     const float* offset = row_offsets;
+    const auto none = hn::Lt(one, zero);  // all false
     for (int k = 0; k < a.directions; ++k) {
       VF blocked = zero;
-      auto seen = hn::Lt(one, zero);  // all false
+      auto seen = none;
+      // The previous point of the direction (the receiver first) and, on lanes where it lay
+      // hidden behind the visible surface of its pixel, that surface's tangent plane
+      // dot(x, n) = w (Hemisphere::crossing).
+      [[maybe_unused]] VF ax = px, ay = py, az = pz;
+      [[maybe_unused]] auto previous_hidden = none;
+      [[maybe_unused]] VF pnx = zero, pny = zero, pnz = zero, pw = zero;
       const float* const direction_end = offset + size_t(a.steps) * 3 * kLaneTable;
       for (int step = 0; step < a.steps; ++step, offset += 3 * kLaneTable) {
         // A direction fully blocked on every lane stays so (it counts its strongest occluder,
@@ -138,79 +220,98 @@ void hemisphere_row(const HemisphereRowArgs& a, int y, int x0, int x1, float* ou
         const VF sx = hn::MulAdd(tx, ox, hn::MulAdd(bx, oy, hn::MulAdd(nx, oz, px)));
         const VF sy = hn::MulAdd(ty, ox, hn::MulAdd(by, oy, hn::MulAdd(ny, oz, py)));
         const VF sz = hn::MulAdd(tz, ox, hn::MulAdd(bz, oy, hn::MulAdd(nz, oz, pz)));
-        // Project (CameraModel::project).
-        VF su, sv;
-        auto in_image = hn::Gt(hn::Neg(sz), zero);
-        if (cam.orthographic) {
-          su = hn::MulAdd(sx, inv_scale_u, center_u);
-          sv = hn::NegMulAdd(sy, inv_scale_v, center_v);
-          in_image = hn::Lt(zero, one);  // all true
-        } else {
-          // 1 / depth: the hardware estimate refined by one Newton step (relative error
-          // below 1e-7, as a division's, at a fraction of its cost).
-          const VF depth_s = hn::Neg(sz);
-          const VF estimate = hn::ApproximateReciprocal(depth_s);
-          const VF inv = estimate * hn::NegMulAdd(depth_s, estimate, two);
-          su = hn::MulAdd(sx * inv, inv_scale_u, center_u);
-          sv = hn::NegMulAdd(sy * inv, inv_scale_v, center_v);
-        }
-        in_image = hn::And(in_image, hn::And(hn::And(hn::Ge(su, zero), hn::Ge(sv, zero)),
-                                             hn::And(hn::Lt(su, width_f), hn::Lt(sv, height_f))));
-        in_image = hn::And(in_image, receiver);
+        VI qx = hn::Zero(di), qy = hn::Zero(di);
+        const auto in_image = hn::And(project_to_pixel(cam, a.width, a.height, sx, sy, sz, qx, qy), receiver);
         seen = hn::Or(seen, in_image);
-        if (hn::AllFalse(df, in_image)) continue;
-        const VI qx = hn::ConvertTo(di, hn::IfThenElseZero(in_image, su));
-        const VI qy = hn::ConvertTo(di, hn::IfThenElseZero(in_image, sv));
-        const VI index = qy * hn::Set(di, a.width) + qx;
-        const VF qd = hn::GatherIndex(df, a.depth, index);
-        // The visible surface at that pixel (Frame::position).
-        const VF q_scale = cam.orthographic ? one : qd;
-        const VF qxv = hn::MulAdd(hn::ConvertTo(df, qx), scale_u, pixel_u0) * q_scale;
-        const VF qyv = hn::NegMulAdd(hn::ConvertTo(df, qy), scale_v, pixel_v0) * q_scale;
-        const VF qzv = hn::Neg(qd);
-        const VF behind = qzv - sz;  // > 0: the visible surface is in front of the sample
-        if (a.extra_layers > 0) {
-          const auto behind_visible =
-              hn::And(hn::And(in_image, hn::Lt(qd, inf)), hn::Gt(behind, zero));
-          if (hn::AllFalse(df, behind_visible)) continue;
-          // Frame::solid_entry on the lanes: walk the hits behind the visible one until the one
-          // the sample lies in front of.
-          const VF sample_depth = hn::Neg(sz);
-          VF entry = qd;
-          auto entered = behind_visible;    // the visible surface is a front face
-          auto open = behind_visible;       // not yet placed between two hits
-          auto closed = hn::Lt(one, zero);  // all false
-          for (int layer = 0; layer < a.extra_layers; ++layer) {
-            const VF hit = hn::GatherIndex(df, a.layers + size_t(layer) * a.plane, index);
-            const VF hit_depth = hn::Abs(hit);
-            const auto back = hn::Lt(hit, zero);
-            const auto here = hn::And(open, hn::Le(sample_depth, hit_depth));
-            closed = hn::Or(closed, hn::And(here, hn::And(entered, back)));
-            const auto past = hn::AndNot(here, open);  // open lanes behind this hit
-            entry = hn::IfThenElse(past, hit_depth, entry);
-            entered = hn::Or(hn::AndNot(past, entered), hn::AndNot(back, past));
-            open = past;
-            if (hn::AllFalse(df, open)) break;
+        auto hidden = none;
+        VF qxv = zero, qyv = zero, qzv = zero;
+        VI index = hn::Zero(di);
+        if (!hn::AllFalse(df, in_image)) {
+          index = qy * hn::Set(di, a.width) + qx;
+          const VF qd = hn::GatherIndex(df, a.depth, index);
+          // The visible surface at that pixel (Frame::position).
+          const VF q_scale = cam.orthographic ? one : qd;
+          qxv = hn::MulAdd(hn::ConvertTo(df, qx), scale_u, pixel_u0) * q_scale;
+          qyv = hn::NegMulAdd(hn::ConvertTo(df, qy), scale_v, pixel_v0) * q_scale;
+          qzv = hn::Neg(qd);
+          const VF behind = qzv - sz;  // > 0: the visible surface is in front of the sample
+          hidden = hn::And(hn::And(in_image, hn::Lt(qd, inf)), hn::Gt(behind, zero));
+          if constexpr (kLayers) {
+            if (!hn::AllFalse(df, hidden)) {
+              // Frame::solid_entry on the lanes: walk the hits behind the visible one until the
+              // one the sample lies in front of.
+              const VF sample_depth = hn::Neg(sz);
+              VF entry = qd;
+              auto entered = hidden;  // the visible surface is a front face
+              auto open = hidden;     // not yet placed between two hits
+              auto closed = none;
+              for (int layer = 0; layer < a.extra_layers; ++layer) {
+                const VF hit = hn::GatherIndex(df, a.layers + size_t(layer) * a.plane, index);
+                const VF hit_depth = hn::Abs(hit);
+                const auto back = hn::Lt(hit, zero);
+                const auto here = hn::And(open, hn::Le(sample_depth, hit_depth));
+                closed = hn::Or(closed, hn::And(here, hn::And(entered, back)));
+                const auto past = hn::AndNot(here, open);  // open lanes behind this hit
+                entry = hn::IfThenElse(past, hit_depth, entry);
+                entered = hn::Or(hn::AndNot(past, entered), hn::AndNot(back, past));
+                open = past;
+                if (hn::AllFalse(df, open)) break;
+              }
+              // Occluded by the solid entered at `entry` (inside it when a back face closes it,
+              // else within the assumed thickness), when that surface is above the tangent
+              // plane.
+              const VF entry_scale = cam.orthographic ? one : entry;
+              const VF ex = hn::MulAdd(hn::ConvertTo(df, qx), scale_u, pixel_u0) * entry_scale;
+              const VF ey = hn::NegMulAdd(hn::ConvertTo(df, qy), scale_v, pixel_v0) * entry_scale;
+              const VF entry_level = hn::MulAdd(ex, nx, hn::MulAdd(ey, ny, hn::Neg(entry) * nz));
+              const auto counts =
+                  hn::And(hn::And(hidden, entered), hn::Gt(entry_level, plane_level));
+              const VF thick =
+                  hn::Min(one, hn::Max(zero, two - (sample_depth - entry) * inv_thickness));
+              const VF weight = hn::IfThenElse(closed, one, thick);
+              blocked = hn::Max(blocked, hn::IfThenElseZero(counts, weight));
+            }
+          } else {
+            const VF level = hn::MulAdd(qxv, nx, hn::MulAdd(qyv, ny, qzv * nz));
+            const auto counts = hn::And(hidden, hn::Gt(level, plane_level));
+            const VF weight = hn::Min(one, hn::Max(zero, two - behind * inv_thickness));
+            blocked = hn::Max(blocked, hn::IfThenElseZero(counts, weight));
           }
-          // Occluded by the solid entered at `entry` (inside it when a back face closes it,
-          // else within the assumed thickness), when that surface is above the tangent plane.
-          const VF entry_scale = cam.orthographic ? one : entry;
-          const VF ex = hn::MulAdd(hn::ConvertTo(df, qx), scale_u, pixel_u0) * entry_scale;
-          const VF ey = hn::NegMulAdd(hn::ConvertTo(df, qy), scale_v, pixel_v0) * entry_scale;
-          const VF entry_level = hn::MulAdd(ex, nx, hn::MulAdd(ey, ny, hn::Neg(entry) * nz));
-          const auto counts =
-              hn::And(hn::And(behind_visible, entered), hn::Gt(entry_level, plane_level));
-          const VF thick =
-              hn::Min(one, hn::Max(zero, two - (sample_depth - entry) * inv_thickness));
-          const VF weight = hn::IfThenElse(closed, one, thick);
-          blocked = hn::Max(blocked, hn::IfThenElseZero(counts, weight));
-          continue;
         }
-        const VF level = hn::MulAdd(qxv, nx, hn::MulAdd(qyv, ny, qzv * nz));
-        const auto counts = hn::And(hn::And(in_image, hn::Lt(qd, inf)),
-                                    hn::And(hn::Gt(behind, zero), hn::Gt(level, plane_level)));
-        const VF weight = hn::Min(one, hn::Max(zero, two - behind * inv_thickness));
-        blocked = hn::Max(blocked, hn::IfThenElseZero(counts, weight));
+        if constexpr (kLayers) {
+          // Between the previous point and this one the direction may have passed through a
+          // surface that neither lies in (a 2 cm board between two steps): the plane of the
+          // surface this sample is hidden behind, else the previous point's (Hemisphere::pixel);
+          // surfaces above the tangent plane only.
+          hidden = hn::And(hn::And(hidden, hn::Lt(blocked, one)),
+                           hn::Gt(hn::MulAdd(qxv, nx, hn::MulAdd(qyv, ny, qzv * nz)), plane_level));
+          VF hnx = zero, hny = zero, hnz = zero, hw = zero;
+          if (!hn::AllFalse(df, hn::Or(hidden, hn::And(previous_hidden, hn::Lt(blocked, one))))) {
+            if (!hn::AllFalse(df, hidden)) {
+              const VI packed =
+                  hn::GatherIndex(di, reinterpret_cast<const int32_t*>(a.normals), index);
+              decode_normals(df, packed, hnx, hny, hnz);
+              hw = hn::MulAdd(qxv, hnx, hn::MulAdd(qyv, hny, qzv * hnz));
+            }
+            const auto flips = [&](VF cx, VF cy, VF cz, VF w) {
+              return hn::Xor(hn::Gt(hn::MulAdd(ax, cx, hn::MulAdd(ay, cy, az * cz)), w),
+                             hn::Gt(hn::MulAdd(sx, cx, hn::MulAdd(sy, cy, sz * cz)), w));
+            };
+            const auto here = hn::And(hidden, flips(hnx, hny, hnz, hw));
+            const VF cnx = hn::IfThenElse(here, hnx, pnx), cny = hn::IfThenElse(here, hny, pny),
+                     cnz = hn::IfThenElse(here, hnz, pnz), cw = hn::IfThenElse(here, hw, pw);
+            const auto candidate = hn::And(
+                hn::And(hn::Or(here, previous_hidden), flips(cnx, cny, cnz, cw)),
+                hn::Lt(blocked, one));
+            if (!hn::AllFalse(df, candidate)) {
+              blocked = hn::Max(
+                  blocked, crossing_lanes(a, candidate, ax, ay, az, sx, sy, sz, cnx, cny, cnz, cw));
+            }
+          }
+          ax = sx, ay = sy, az = sz;
+          previous_hidden = hidden;
+          pnx = hnx, pny = hny, pnz = hnz, pw = hw;
+        }
       }
       offset = direction_end;
       valid = valid + hn::IfThenElseZero(seen, one);
@@ -221,6 +322,14 @@ void hemisphere_row(const HemisphereRowArgs& a, int y, int x0, int x1, float* ou
         hn::IfThenElse(any, one - occlusion / hn::IfThenElse(any, valid, one), one);
     hn::Store(hn::IfThenElse(receiver, visibility, one), df, result);
     std::copy_n(result, count, out + (x - x0));
+  }
+}
+
+void hemisphere_row(const HemisphereRowArgs& a, int y, int x0, int x1, float* out) {
+  if (a.extra_layers > 0) {
+    hemisphere_row_of<true>(a, y, x0, x1, out);
+  } else {
+    hemisphere_row_of<false>(a, y, x0, x1, out);
   }
 }
 
@@ -251,6 +360,9 @@ class Hemisphere final : public Variant {
     radius_ = float(v.get_float("radius"));
     bias_ = float(v.get_float("bias"));
     thickness_ = float(v.get_float("thickness")) * radius_;
+    // How far behind the crossed plane the depth image may show a surface at the crossing point
+    // and still have it taken as that surface (tangent planes of curved surfaces drift).
+    crossing_tolerance_ = 0.25f * thickness_;
     directions_ = count_or_preset(v, "samples", kSamples);
     steps_ = count_or_preset(v, "steps", kSteps);
     // Each kernel direction is followed by `steps` samples at increasing distances;
@@ -292,7 +404,8 @@ class Hemisphere final : public Variant {
     const HemisphereRowArgs args{
         f.depth_plane(), f.normal_plane(),    f.layer_planes(),        f.extra_layers(),
         f.width(),       f.height(),          f.camera().intrinsics(), radius_,
-        bias_ * radius_, thickness_,          f.pixel_count(),         directions_,
+        bias_ * radius_, thickness_,          crossing_tolerance_,     f.pixel_count(),
+        directions_,
         steps_,          lane_offsets_.data()};
     for (int y = t.y0; y < t.y1; ++y) {
       best_hemisphere_row()(args, y, t.x0, t.x1, visibility + f.index(t.x0, y));
@@ -320,21 +433,51 @@ class Hemisphere final : public Variant {
     for (int k = 0; k < directions_; ++k) {
       float blocked = 0.0f;
       bool seen = false;
+      // The previous point of the direction (the receiver first) and, when it lay hidden behind
+      // the visible surface of its pixel, that surface's tangent plane: see crossing().
+      Vec3 previous = p;
+      bool previous_hidden = false;
+      Vec3 previous_surface{}, previous_normal{};
       for (int step = 0; step < steps_; ++step, ++offset) {
         const Vec3 sample = p + tangent * offset->x + bitangent * offset->y + normal * offset->z;
-        int qx, qy;
-        if (!pixel_of_sample(f, sample, qx, qy)) continue;
-        seen = true;
-        if (!f.is_geometry(qx, qy)) continue;
-        // The surface the sample lies behind (the visible one without extra layers), if any.
-        bool closed = false;
-        const float entry = f.solid_entry(qx, qy, -sample.z, closed);
-        if (entry == Frame::kBackground) continue;
-        const Vec3 q = f.camera().view_position(float(qx) + 0.5f, float(qy) + 0.5f, entry);
-        if (dot(q - p, normal) <= min_height) continue;  // at or below the tangent plane
-        // Inside a solid that a back face closes, or within the assumed thickness.
-        blocked =
-            std::max(blocked, closed ? 1.0f : thickness_weight(-sample.z - entry, thickness_));
+        int qx = -1, qy = -1;
+        bool hidden = false;
+        Vec3 surface{}, surface_normal{};
+        if (pixel_of_sample(f, sample, qx, qy)) {
+          seen = true;
+          if (f.is_geometry(qx, qy)) {
+            surface = f.position(qx, qy);
+            hidden = -sample.z > -surface.z;
+            // The surface the sample lies behind (the visible one without extra layers), if any.
+            bool closed = false;
+            const float entry = f.solid_entry(qx, qy, -sample.z, closed);
+            if (entry != Frame::kBackground) {
+              const Vec3 q = f.camera().view_position(float(qx) + 0.5f, float(qy) + 0.5f, entry);
+              // Inside a solid that a back face closes, or within the assumed thickness, when
+              // above the tangent plane.
+              if (dot(q - p, normal) > min_height) {
+                blocked = std::max(
+                    blocked, closed ? 1.0f : thickness_weight(-sample.z - entry, thickness_));
+              }
+            }
+            // The crossing test (below) takes surfaces above the tangent plane only, as the
+            // test above.
+            hidden = hidden && dot(surface - p, normal) > min_height;
+            if (hidden) surface_normal = f.normal(qx, qy);
+          }
+        }
+        // Between the two points the direction may have passed through a surface that neither
+        // point lies in (a 2 cm board between two steps): the plane of the surface this sample
+        // is hidden behind, else that of the one the previous point was hidden behind.
+        if (f.extra_layers() > 0 && blocked < 1.0f && (hidden || previous_hidden)) {
+          const bool here = hidden && sides_differ(previous, sample, surface, surface_normal);
+          blocked = std::max(blocked, crossing(f, previous, sample, here ? surface : previous_surface,
+                                               here ? surface_normal : previous_normal));
+        }
+        previous = sample;
+        previous_hidden = hidden;
+        previous_surface = surface;
+        previous_normal = surface_normal;
       }
       if (!seen) continue;
       ++valid;
@@ -343,7 +486,32 @@ class Hemisphere final : public Variant {
     return valid > 0 ? 1.0f - occlusion / float(valid) : 1.0f;
   }
 
-  float radius_, bias_, thickness_;
+  static bool sides_differ(Vec3 a, Vec3 b, Vec3 q, Vec3 nq) {
+    return (dot(a - q, nq) > 0.0f) != (dot(b - q, nq) > 0.0f);
+  }
+
+  // 1 when the segment from a to b passes through the visible surface of a pixel that one of
+  // them lies hidden behind: it goes from one side of that surface's tangent plane (point q,
+  // normal nq) to the other, and where it meets the plane the depth image shows that plane (or
+  // something in front of it), so the crossing point is on a surface, not in open air beside
+  // one.
+  float crossing(const Frame& f, Vec3 a, Vec3 b, Vec3 q, Vec3 nq) const {
+    const float side_a = dot(a - q, nq), side_b = dot(b - q, nq);
+    if ((side_a > 0.0f) == (side_b > 0.0f)) return 0.0f;
+    const Vec3 c = a + (b - a) * (side_a / (side_a - side_b));
+    int cx, cy;
+    if (!pixel_of_sample(f, c, cx, cy) || !f.is_geometry(cx, cy)) return 0.0f;
+    // The plane's depth on the ray through that pixel's centre.
+    const CameraModel& cam = f.camera();
+    const float u = float(cx) + 0.5f, v = float(cy) + 0.5f;
+    const Vec3 origin = cam.view_position(u, v, 0.0f);
+    const float slope = dot(cam.view_position(u, v, 1.0f) - origin, nq);
+    if (!(std::fabs(slope) > 1e-6f)) return 0.0f;
+    const float plane_depth = dot(q - origin, nq) / slope;
+    return f.depth(cx, cy) <= plane_depth + crossing_tolerance_ ? 1.0f : 0.0f;
+  }
+
+  float radius_, bias_, thickness_, crossing_tolerance_;
   int directions_, steps_;
   std::vector<Vec3> offsets_;        // [jitter state][direction][step]
   std::vector<float> lane_offsets_;  // [y & 3][sample][x, y, z][lane]
