@@ -16,9 +16,10 @@ HWY_BEFORE_NAMESPACE();
 namespace ssao {
 namespace HWY_NAMESPACE {
 
-// Unit normals from packed snorm16 octahedral coordinates (decode_normal in frame.h).
+// Directions (not of unit length) from packed snorm16 octahedral coordinates: what a test that
+// only compares sides of a plane needs (decode_normal in frame.h without its normalisation).
 template <class DF, class VI, class VF = hwy::HWY_NAMESPACE::Vec<DF>>
-HWY_INLINE void decode_normals(DF df, VI packed, VF& nx, VF& ny, VF& nz) {
+HWY_INLINE void decode_directions(DF df, VI packed, VF& nx, VF& ny, VF& nz) {
   namespace hn = hwy::HWY_NAMESPACE;
   const VF one = hn::Set(df, 1.0f), zero = hn::Zero(df);
   const VF scale16 = hn::Set(df, 1.0f / 32767.0f);
@@ -28,7 +29,14 @@ HWY_INLINE void decode_normals(DF df, VI packed, VF& nx, VF& ny, VF& nz) {
   const auto folded = hn::Lt(nz, zero);
   nx = hn::IfThenElse(folded, hn::CopySign(one - hn::Abs(ov), ou), ou);
   ny = hn::IfThenElse(folded, hn::CopySign(one - hn::Abs(ou), ov), ov);
-  const VF inv_length = one / hn::Sqrt(nx * nx + ny * ny + nz * nz);
+}
+
+// Unit normals from packed snorm16 octahedral coordinates (decode_normal in frame.h).
+template <class DF, class VI, class VF = hwy::HWY_NAMESPACE::Vec<DF>>
+HWY_INLINE void decode_normals(DF df, VI packed, VF& nx, VF& ny, VF& nz) {
+  namespace hn = hwy::HWY_NAMESPACE;
+  decode_directions(df, packed, nx, ny, nz);
+  const VF inv_length = hn::Set(df, 1.0f) / hn::Sqrt(nx * nx + ny * ny + nz * nz);
   nx = nx * inv_length, ny = ny * inv_length, nz = nz * inv_length;
 }
 

@@ -101,30 +101,36 @@ HWY_INLINE VF crossing_lanes(const HemisphereRowArgs& a, M candidate, VF ax, VF 
   const VF zero = hn::Zero(df), one = hn::Set(df, 1.0f);
   const VF side_a = hn::MulAdd(ax, cx, hn::MulAdd(ay, cy, az * cz)) - w;
   const VF side_b = hn::MulAdd(bx, cx, hn::MulAdd(by, cy, bz * cz)) - w;
-  const VF t = side_a / hn::IfThenElse(candidate, side_a - side_b, one);
+  // t = side_a / (side_a - side_b) in (0, 1]: a reciprocal estimate refined by a Newton step.
+  const VF span = hn::IfThenElse(candidate, side_a - side_b, one);
+  const VF estimate = hn::ApproximateReciprocal(span);
+  const VF t = side_a * (estimate * hn::NegMulAdd(span, estimate, hn::Set(df, 2.0f)));
   const VF px = hn::MulAdd(bx - ax, t, ax), py = hn::MulAdd(by - ay, t, ay),
            pz = hn::MulAdd(bz - az, t, az);
-  auto lanes = candidate;
   hn::Vec<decltype(di)> qx, qy;
-  lanes = hn::And(lanes, project_to_pixel(cam, a.width, a.height, px, py, pz, qx, qy));
+  const auto lanes = hn::And(candidate, project_to_pixel(cam, a.width, a.height, px, py, pz, qx, qy));
   if (hn::AllFalse(df, lanes)) return zero;
   // (qx, qy) are 0 on lanes outside the image: every index is in the plane.
   const VF depth = hn::GatherIndex(df, a.depth, qy * hn::Set(di, a.width) + qx);
-  // The plane's depth on the ray through that pixel's centre: origin o + depth * direction r.
-  const VF u = (hn::ConvertTo(df, qx) + hn::Set(df, 0.5f) - hn::Set(df, cam.center_u)) *
-               hn::Set(df, cam.scale_u);
-  const VF v = (hn::Set(df, cam.center_v) - hn::ConvertTo(df, qy) - hn::Set(df, 0.5f)) *
-               hn::Set(df, cam.scale_v);
+  // The plane meets the ray through that pixel's centre, origin o + depth * direction r, at
+  // depth numerator / slope; the surface shown there is on or in front of it when
+  // depth * slope <= numerator + tolerance * slope (slope > 0; both sides negated otherwise).
+  const VF u = hn::MulAdd(hn::ConvertTo(df, qx), hn::Set(df, cam.scale_u),
+                          hn::Set(df, (0.5f - cam.center_u) * cam.scale_u));
+  const VF v = hn::NegMulAdd(hn::ConvertTo(df, qy), hn::Set(df, cam.scale_v),
+                             hn::Set(df, (cam.center_v - 0.5f) * cam.scale_v));
   VF numerator = w, slope = hn::Neg(cz);  // orthographic: o = (u, v, 0), r = (0, 0, -1)
   if (cam.orthographic) {
     numerator = w - hn::MulAdd(u, cx, v * cy);
   } else {  // o = 0, r = (u, v, -1)
     slope = hn::MulAdd(u, cx, hn::MulSub(v, cy, cz));
   }
-  lanes = hn::And(lanes, hn::Gt(hn::Abs(slope), hn::Set(df, 1e-6f)));
-  const VF plane_depth = numerator / hn::IfThenElse(lanes, slope, one);
-  const auto on_surface = hn::And(
-      lanes, hn::Le(depth, plane_depth + hn::Set(df, a.crossing_tolerance)));
+  const VF sign = hn::CopySign(one, slope);
+  const VF abs_slope = hn::Abs(slope);
+  const auto on_surface =
+      hn::And(hn::And(lanes, hn::Gt(abs_slope, hn::Set(df, 1e-6f))),
+              hn::Le(depth * abs_slope,
+                     hn::MulAdd(hn::Set(df, a.crossing_tolerance), abs_slope, numerator * sign)));
   return hn::IfThenElseZero(on_surface, one);
 }
 
@@ -290,7 +296,7 @@ HWY_INLINE void hemisphere_row_of(const HemisphereRowArgs& a, int y, int x0, int
             if (!hn::AllFalse(df, hidden)) {
               const VI packed =
                   hn::GatherIndex(di, reinterpret_cast<const int32_t*>(a.normals), index);
-              decode_normals(df, packed, hnx, hny, hnz);
+              decode_directions(df, packed, hnx, hny, hnz);  // sides of a plane: any length
               hw = hn::MulAdd(qxv, hnx, hn::MulAdd(qyv, hny, qzv * hnz));
             }
             const auto flips = [&](VF cx, VF cy, VF cz, VF w) {
