@@ -183,7 +183,7 @@ SSAO_API ssao_status ssao_job_get_floats(ssao_job job, const char* name, double*
  *               A sample point counts as occluded inside a solid (behind a front face and in
  *               front of the back face that follows it); behind the last front face the ray
  *               knows, the "thickness" rule applies as with one layer. Variants that read the
- *               layers: "hemisphere" (docs/variants.md); the others ignore them.
+ *               layers: "hemisphere" and "horizon" (docs/variants.md); the others ignore them.
  * All images of a job must have the depth image's width and height, unless an output window
  * is set (ssao_job_set_output_window). */
 SSAO_API ssao_status ssao_job_set_image(ssao_job job, const char* name, float* data, int width,

@@ -27,6 +27,9 @@ namespace {
 
 constexpr float kPi = 3.14159265358979323846f;
 constexpr int kSectors = 32;
+// An open surface (a card: a front face followed by another front face) is this fraction of the
+// assumed thickness deep.
+constexpr float kCardThickness = 0.1f;
 
 // atan(z) for |z| <= 1, error below 2e-6 rad (minimax polynomial in z^2).
 inline float atan_unit(float z) {
@@ -112,6 +115,7 @@ class Horizon final : public Variant {
     const Line* line = lines_.data() + size_t(j) * slices_;
     const float* fractions = step_fractions_.data() + size_t(j) * steps_;
     const float u0 = float(x) + 0.5f, v0 = float(y) + 0.5f;
+    const bool layered = f.extra_layers() > 0;
 
     float visible_sum = 0.0f, total_sum = 0.0f;
     for (int s = 0; s < slices_; ++s) {
@@ -151,6 +155,7 @@ class Horizon final : public Variant {
           if (qd == Frame::kBackground) continue;
           const Vec3 q = cam.view_position(float(qx) + 0.5f, float(qy) + 0.5f, qd);
           const Vec3 front = q - p;
+          if (layered) occluded |= solid_sectors(f, qx, qy, p, n, min_height, e_n, e_t);
           if (dot(front, front) > radius2) {
             chained = false;
             continue;
@@ -162,7 +167,7 @@ class Horizon final : public Variant {
           chained = true;
           previous_beta = beta_front;
           previous_depth = qd;
-          if (!occluder) continue;
+          if (!occluder || layered) continue;
           // The occluder is assumed `thickness` deep along the ray through q.
           const Vec3 back = front - cam.towards_camera(q) * thickness_;
           occluded |= sector_mask(beta_front, fast_atan2(dot(back, e_t), dot(back, e_n)));
@@ -174,6 +179,55 @@ class Horizon final : public Variant {
       total_sum += projected_length * total;
     }
     return total_sum > 0.0f ? saturate(visible_sum / total_sum) : 1.0f;
+  }
+
+  // With extra depth layers: the sectors covered by the solids that pixel (qx, qy)'s ray crosses,
+  // each the stretch of the ray from a front face to the back face that closes it, cut to the
+  // sphere of `radius` around p. A front face followed by another front face is an open surface
+  // (a card), taken as thin; a front face that nothing closes is taken `thickness` deep.
+  uint32_t solid_sectors(const Frame& f, int qx, int qy, Vec3 p, Vec3 n, float min_height,
+                         Vec3 e_n, Vec3 e_t) const {
+    const CameraModel& cam = f.camera();
+    const float u = float(qx) + 0.5f, v = float(qy) + 0.5f;
+    uint32_t bits = 0;
+    const auto add = [&](float near_depth, float far_depth) {
+      Vec3 a = cam.view_position(u, v, near_depth) - p;
+      Vec3 b = cam.view_position(u, v, far_depth) - p;
+      // Cut the segment a..b to |x| <= radius: t^2 |d|^2 + 2 t a.d + |a|^2 - r^2 = 0.
+      const Vec3 d = b - a;
+      const float dd = dot(d, d), ad = dot(a, d), c = dot(a, a) - radius_ * radius_;
+      const float disc = ad * ad - dd * c;
+      if (!(disc > 0.0f) || !(dd > 0.0f)) return;
+      const float root = std::sqrt(disc);
+      const float t0 = std::max(0.0f, (-ad - root) / dd), t1 = std::min(1.0f, (-ad + root) / dd);
+      if (!(t0 < t1)) return;
+      const Vec3 a_cut = a + d * t0, b_cut = a + d * t1;
+      if (dot(a_cut, n) <= min_height && dot(b_cut, n) <= min_height) return;
+      bits |= sector_mask(fast_atan2(dot(a_cut, e_t), dot(a_cut, e_n)),
+                          fast_atan2(dot(b_cut, e_t), dot(b_cut, e_n)));
+    };
+    const size_t index = f.index(qx, qy);
+    const float* layers = f.layer_planes();
+    float entry = f.depth(qx, qy);
+    bool inside = true;  // the visible surface is taken as a front face
+    for (int k = 0; k < f.extra_layers(); ++k) {
+      const float hit = layers[size_t(k) * f.pixel_count() + index];
+      if (hit == Frame::kBackground) break;
+      const float depth = std::fabs(hit);
+      const bool back = hit < 0.0f;
+      if (inside && back) {
+        add(entry, depth);
+        inside = false;
+      } else if (inside) {  // an open surface at `entry`: thin
+        add(entry, entry + kCardThickness * thickness_);
+        entry = depth;
+      } else if (!back) {
+        entry = depth;
+        inside = true;
+      }
+    }
+    if (inside) add(entry, entry + thickness_);
+    return bits;
   }
 
   // Sectors between two angles (either order), each clamped to the hemisphere; a sector counts
