@@ -344,6 +344,7 @@ void hemisphere_row(const HemisphereRowArgs& a, int y, int x0, int x1, float* ou
 HWY_AFTER_NAMESPACE();
 
 #if HWY_ONCE
+#include <cmath>
 #include <vector>
 
 #include "variant.h"
@@ -379,16 +380,32 @@ class Hemisphere final : public Variant {
     const float spacing = steps_ == 1 ? 1.0f / float(directions_) : 1.0f / float(steps_);
     const auto states = jitter_states(uint32_t(v.get_int("seed")));
     const int samples = directions_ * steps_;
+    // The sub-stratum of the radii per tile position (x, y): 4 * L3 + L1 with L1 = x ^ y and
+    // L3 = x ^ 3y, orthogonal Latin squares over GF(4), so that every row and every column of
+    // the tile holds one offset from each quarter (mean 7.5 / 16 each). jitter_states' own
+    // order gives the four row classes means 6, 10, 5 and 9 / 16: rows y & 3 = 1, 3 reached
+    // farther than rows 0, 2, alternate rows streaked where denoise=none leaves them.
+    int radial_index[kJitterStates] = {};
+    for (int ty = 0; ty < kNoiseTileSize; ++ty) {
+      for (int tx = 0; tx < kNoiseTileSize; ++tx) {
+        static constexpr int kTimes3[4] = {0, 3, 1, 2};  // multiplication by 3 in GF(4)
+        radial_index[jitter_index(tx, ty)] = 4 * (tx ^ kTimes3[ty]) + (tx ^ ty);
+      }
+    }
     offsets_.resize(size_t(kJitterStates) * samples);
     for (int j = 0; j < kJitterStates; ++j) {
       const JitterState& js = states[j];
+      // The seed's shift of the sub-stratum, kept.
+      const float seed_shift = js.radial_offset * float(kJitterStates) -
+                               std::floor(js.radial_offset * float(kJitterStates));
+      const float radial_offset = (float(radial_index[j]) + seed_shift) / float(kJitterStates);
       for (int k = 0; k < directions_; ++k) {
         const Vec3 d = kernel.directions[k];
         const Vec3 rotated{d.x * js.cos_angle - d.y * js.sin_angle,
                            d.x * js.sin_angle + d.y * js.cos_angle, d.z};
         for (int step = 0; step < steps_; ++step) {
           const float stratum = float(steps_ == 1 ? kernel.stratum[k] : step) * spacing;
-          const float r = radius_ * radial_scale(stratum + js.radial_offset * spacing, clustering);
+          const float r = radius_ * radial_scale(stratum + radial_offset * spacing, clustering);
           offsets_[(size_t(j) * directions_ + k) * steps_ + step] = rotated * r;
         }
       }
