@@ -89,12 +89,15 @@ void Frame::build_depth(const FrameInputs& in, TilePool& pool, Progress& progres
 void Frame::fill_depth(const FrameInputs& in, TilePool& pool, Progress& progress) {
   const float limit = in.background_limit;
   pool.for_each_tile(width_, height_, progress, [&](const Tile& t) {
+    ScratchVector<float> facing(extra_layers_ > 0 ? size_t(t.x1 - t.x0) : 0);
     for (int y = t.y0; y < t.y1; ++y) {
       float* row = depth_.data() + index(t.x0, y);
       in.depth.read_channel0(t.x0, y, t.x1 - t.x0, row);
       planar_depth_row(camera_.intrinsics(), row, t.x0, t.x1 - t.x0, float(y) + 0.5f,
                        in.radial_depth, limit);
-      for (int k = 0; k < extra_layers_; ++k) layer_row(in, k, t.x0, t.x1 - t.x0, y, limit);
+      for (int k = 0; k < extra_layers_; ++k) {
+        layer_row(in, k, t.x0, t.x1 - t.x0, y, limit, facing.data());
+      }
     }
   });
 }
@@ -182,33 +185,56 @@ SSAO_VECTORIZE void Frame::encode_normal_row(const float* rotation, float v, int
 // Hit k + 2 of a row, after the row's visible depths: planar, checked to lie behind the hit
 // before it, the facing folded into the sign. Without a facing image the hits are taken to
 // alternate: the 2nd a back face, the 3rd a front face, ...
-void Frame::layer_row(const FrameInputs& in, int k, int x0, int count, int y, float limit) {
+void Frame::layer_row(const FrameInputs& in, int k, int x0, int count, int y, float limit,
+                      float* facing) {
   float* row = layers_.data() + size_t(k) * pixel_count() + index(x0, y);
   const float* before = k == 0 ? depth_.data() + index(x0, y) : row - pixel_count();
   in.layers[k].read_channel0(x0, y, count, row);
   planar_depth_row(camera_.intrinsics(), row, x0, count, float(y) + 0.5f, in.radial_depth, limit);
-  const bool alternating_back = k % 2 == 0;
-  for (int i = 0; i < count; ++i) {
-    const float previous = std::fabs(before[i]);
-    if (depth_[index(x0 + i, y)] == kBackground) {  // a background pixel has no hits
-      row[i] = kBackground;
-      continue;
-    }
-    if (row[i] != kBackground && !(row[i] >= previous * (1.0f - kLayerOrderTolerance))) {
-      const auto name = [](int layer) {
-        return layer == 1 ? std::string("depth") : "depth" + std::to_string(layer);
-      };
-      throw_invalid_argument(
-          "image '" + name(k + 2) + "' at pixel (" + std::to_string(x0 + i) + ", " +
-          std::to_string(y) + ") is nearer than '" + name(k + 1) + "' (" +
-          (previous == kBackground ? std::string("no hit") : std::to_string(previous)) +
-          " planar): extra depth layers must be the hits behind the visible surface, in order");
-    }
-    const float depth = std::max(row[i], previous);
-    const bool back =
-        in.facing[k].attached() ? in.facing[k].pixel(x0 + i, y)[0] >= 0.5f : alternating_back;
-    row[i] = back && depth != kBackground ? -depth : depth;
+  // Hit k as the facing image says, else alternating (the 2nd a back face, the 3rd a front...).
+  if (in.facing[k].attached()) {
+    in.facing[k].read_channel0(x0, y, count, facing);
+  } else {
+    std::fill_n(facing, count, k % 2 == 0 ? 1.0f : 0.0f);
   }
+  const int out_of_order = pack_layer_row(depth_.data() + index(x0, y), before, facing, count, row);
+  if (out_of_order >= 0) {
+    const auto name = [](int layer) {
+      return layer == 1 ? std::string("depth") : "depth" + std::to_string(layer);
+    };
+    const float previous = std::fabs(before[out_of_order]);
+    throw_invalid_argument(
+        "image '" + name(k + 2) + "' at pixel (" + std::to_string(x0 + out_of_order) + ", " +
+        std::to_string(y) + ") is nearer than '" + name(k + 1) + "' (" +
+        (previous == kBackground ? std::string("no hit") : std::to_string(previous)) +
+        " planar): extra depth layers must be the hits behind the visible surface, in order");
+  }
+}
+
+// A row of hit k in place: planar depth, negated on a back face (facing >= 0.5), background
+// where the pixel is. Returns the first pixel whose hit is nearer than the hit before it (by
+// more than kLayerOrderTolerance), or -1. Branch-free, so the loop vectorises.
+SSAO_VECTORIZE int Frame::pack_layer_row(const float* __restrict depth,
+                                         const float* __restrict before,
+                                         const float* __restrict facing, int count,
+                                         float* __restrict row) {
+  const auto out_of_order = [&](int i) {
+    return depth[i] != kBackground && row[i] != kBackground &&
+           !(row[i] >= std::fabs(before[i]) * (1.0f - kLayerOrderTolerance));
+  };
+  int any = 0;
+  for (int i = 0; i < count; ++i) any |= int(out_of_order(i));
+  if (any != 0) {
+    for (int i = 0; i < count; ++i) {
+      if (out_of_order(i)) return i;
+    }
+  }
+  for (int i = 0; i < count; ++i) {
+    const float hit = std::max(row[i], std::fabs(before[i]));
+    const bool back = facing[i] >= 0.5f && hit != kBackground;
+    row[i] = depth[i] != kBackground ? (back ? -hit : hit) : kBackground;
+  }
+  return -1;
 }
 
 // The nearest of each 2x2 block of two full-resolution rows: `count` blocks of columns 2 i and

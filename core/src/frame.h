@@ -148,7 +148,11 @@ class Frame {
   void encode_normal_row(const float* rotation, float v, int x0, int count, const float* nx,
                          const float* ny, const float* nz, uint32_t* usable, uint32_t* out) const;
 
-  void layer_row(const FrameInputs& in, int k, int x0, int count, int y, float limit);
+  // Hit k of pixels [x0, x0 + count) of row y into its plane; `facing`: scratch of count floats.
+  void layer_row(const FrameInputs& in, int k, int x0, int count, int y, float limit,
+                 float* facing);
+  static int pack_layer_row(const float* depth, const float* before, const float* facing,
+                            int count, float* row);
 
   CameraModel camera_{CameraParams{}, 1, 1};
   int width_ = 0, height_ = 0, extra_layers_ = 0;
