@@ -16,6 +16,7 @@ Stages (each prints a line as it goes):
    in-process through the C API (build/bin/ssao_eval), interleaved rounds, median of --repeat;
    every image, Cycles' included, scored by ssao_eval over the geometry pixels;
 4. OUT/speed_error.csv, OUT/complexity.csv, OUT/speed_error.png, OUT/complexity.png,
+   OUT/crops.png (benchmarks/crops.py: each scene's worst window beside the reference),
    OUT/performance.md, and per scene the equal-error speed-up over Cycles on stdout.
 """
 import argparse
@@ -30,6 +31,8 @@ import statistics
 import subprocess
 import sys
 import time
+
+import crops  # noqa: E402  (benchmarks/crops.py, beside this file)
 
 REPO_ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 BLENDER_SCRIPTS = os.path.join(REPO_ROOT, "scripts", "blender")
@@ -124,6 +127,8 @@ class Plan:
             self.scenes = [(s, size) for s in dict.fromkeys(name for name, _ in self.scenes)]
             self.reference_samples = {size: samples}
         self.noise_scene = "contact"
+        # The frame size whose scenes are cropped beside the reference.
+        self.crops_size = "%dx%d" % (size or SD)
 
 
 def label(scene, size, level=0):
@@ -624,6 +629,21 @@ def write_markdown(path, images, args, plan, rows, table, complexity, noise, mac
         "",
         layers_table(rows),
         "",
+    ]
+    if os.path.isfile(os.path.join(args.out, "crops.png")):
+        lines += [
+            "## Crops beside the reference",
+            "",
+            "What a mean error does not show: per %s scene, the window of %.1f x the frame "
+            "where the default has its largest band error, cut from Cycles' AO pass (the "
+            "reference), the default with one layer, the default with the layers and the band, "
+            "and Cycles' AO pass at 16 spp (`benchmarks/crops.py`; the window's corner under "
+            "the scene's name)." % (plan.crops_size, crops.CROP_FRACTION),
+            "",
+            "![crops of each method beside the reference](%scrops.png)" % images,
+            "",
+        ]
+    lines += [
         "## Scene complexity",
         "",
         "The heavy scene with every face split in four 0 to %d times: the same shape, so the "
@@ -887,6 +907,14 @@ def main():
     write_csv(os.path.join(args.out, "speed_error.csv"), CSV_COLUMNS, rows)
     write_csv(os.path.join(args.out, "complexity.csv"),
               ["size", "level", "triangles", "method", "samples", "time_s"], complexity)
+    try:
+        crops.write_crops(argparse.Namespace(kit=args.kit, eval=args.eval, size=plan.crops_size,
+                                             cycles=os.path.join(args.out, "cycles"),
+                                             baseline_lib=None),
+                          os.path.join(args.out, "crops.png"))
+    except RuntimeError as error:
+        log("FAILED (the crops): %s" % error)
+        failed.append("crops")
     plot_speed_error(os.path.join(args.out, "speed_error.png"), rows,
                      "Cycles' AO pass at " + ground_truth(plan))
     if complexity:
@@ -900,7 +928,7 @@ def main():
     if args.update_docs and failed:
         log("docs/ left as they were: %s failed" % ", ".join(failed))
     elif args.update_docs:
-        for name in ("speed_error.png", "complexity.png"):
+        for name in ("speed_error.png", "complexity.png", "crops.png"):
             if os.path.isfile(os.path.join(args.out, name)):
                 shutil.copy(os.path.join(args.out, name), os.path.join(REPO_ROOT, "docs", "images"))
         write_markdown(os.path.join(REPO_ROOT, "docs", "performance.md"), "images/", *report,
@@ -914,7 +942,7 @@ def main():
         print("Scene complexity (heavy scene, %s):" % complexity[0]["size"])
         print(complexity_table(complexity))
     print()
-    log("wrote %s/{speed_error.csv,speed_error.png,complexity.csv,complexity.png,"
+    log("wrote %s/{speed_error.csv,speed_error.png,complexity.csv,complexity.png,crops.png,"
         "performance.md} in %.0f s" % (args.out, time.perf_counter() - start))
     if failed:
         fail("incomplete: %s failed (the files hold the rest)" % ", ".join(failed))

@@ -55,7 +55,7 @@ class QuickRunTest(unittest.TestCase):
 
     def test_files_exist(self):
         for name in ("speed_error.csv", "speed_error.png", "complexity.csv", "complexity.png",
-                     "performance.md"):
+                     "crops.png", "performance.md"):
             path = os.path.join(self.out, name)
             self.assertTrue(os.path.isfile(path), path)
             self.assertGreater(os.path.getsize(path), 100, path)
@@ -213,6 +213,30 @@ class SpeedupTest(unittest.TestCase):
         (result,) = speed_error.speedups(rows)
         self.assertAlmostEqual(result["speedup"], 100.0)
         self.assertEqual(result["relation"], "=")
+
+
+class CropsTest(unittest.TestCase):
+    """benchmarks/crops.py picks the window where the band error is, on made-up images."""
+
+    def test_window_holds_the_blotch(self):
+        import numpy as np
+        import crops
+        reference = np.full((90, 160), 0.8)
+        ours = reference.copy()
+        ours[60:66, 120:126] -= 0.3  # a blotch of 6 px: band-pass scale
+        x, y = crops.worst_window(ours, reference, np.ones_like(reference, dtype=bool))
+        w, h = crops.crop_size(ours)
+        self.assertEqual((w, h), (48, 27))
+        self.assertTrue(x <= 120 and 126 <= x + w and y <= 60 and 66 <= y + h, (x, y))
+
+    def test_a_smooth_offset_is_not_band_error(self):
+        import numpy as np
+        import crops
+        ramp = np.tile(np.linspace(0.2, 1.0, 160), (90, 1))
+        # A constant offset passes G(1) - G(6) only at the clamped borders: nothing inside.
+        band = crops.gaussian(ramp + 0.1, 1.0) - crops.gaussian(ramp + 0.1, 6.0)
+        reference = crops.gaussian(ramp, 1.0) - crops.gaussian(ramp, 6.0)
+        self.assertLess(float(np.abs(band - reference)[10:-10, 10:-10].max()), 1e-9)
 
 
 def main():
