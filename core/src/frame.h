@@ -151,8 +151,8 @@ class Frame {
   // Hit k of pixels [x0, x0 + count) of row y into its plane; `facing`: scratch of count floats.
   void layer_row(const FrameInputs& in, int k, int x0, int count, int y, float limit,
                  float* facing);
-  static int pack_layer_row(const float* depth, const float* before, const float* facing,
-                            int count, float* row);
+  static int pack_layer_row(const float* depth, const float* before, const float* facing, int count,
+                            float* row);
 
   CameraModel camera_{CameraParams{}, 1, 1};
   int width_ = 0, height_ = 0, extra_layers_ = 0;

@@ -20,8 +20,7 @@ constexpr double kRadius = 1.0;  // the AO distance of the runs and of the ray-t
 
 // Runs the default variant, with the scene's 2nd and 3rd hits (and facing) when `layers` is set.
 std::vector<float> layered_ao(Scene& s, const Camera& cam, bool layers, bool facing = true,
-                              const char* resolution = "full",
-                              const char* variant = "hemisphere") {
+                              const char* resolution = "full", const char* variant = "hemisphere") {
   return compute_ao(s, cam, kRadius, variant, true, [&](Job& j) {
     j.set("resolution", resolution);
     if (!layers) return;
@@ -143,8 +142,9 @@ TEST(Layers, ThinBoardOverAWallIsNoLighterWithLayers) {
   Camera cam;
   cam.width = 128, cam.height = 128;
   const double wall_z = -2.0, board_y = 0.4, thickness = 0.02;
-  const std::vector<Solid> solids = {{{{0, 0, wall_z}, {0, 0, 1}}},
-                                     box({-4, board_y, wall_z - 0.5}, {4, board_y + thickness, -1})};
+  const std::vector<Solid> solids = {
+      {{{0, 0, wall_z}, {0, 0, 1}}},
+      box({-4, board_y, wall_z - 0.5}, {4, board_y + thickness, -1})};
   Scene s = ray_cast(cam, solids);
   std::vector<size_t> pixels;
   std::vector<double> reference;
@@ -190,19 +190,18 @@ TEST(Layers, HorizonReadsThemAsSolidsInItsSlices) {
   std::vector<double> reference;
   scene.floor_near_contact(s, 2, pixels, reference);
   ASSERT_GT(pixels.size(), 200u);
-  const Error one = error_against(layered_ao(s, cam, false, true, "full", "horizon"), reference,
-                                  pixels);
-  const Error three = error_against(layered_ao(s, cam, true, true, "full", "horizon"), reference,
-                                    pixels);
+  const Error one =
+      error_against(layered_ao(s, cam, false, true, "full", "horizon"), reference, pixels);
+  const Error three =
+      error_against(layered_ao(s, cam, true, true, "full", "horizon"), reference, pixels);
   // The thin post: no halo on the wall behind it.
   Camera post_cam;
   post_cam.width = 128, post_cam.height = 96;
-  Scene post = ray_cast(post_cam, {{{{0, 0, -6}, {0, 0, 1}}},
-                                   box({-0.15, -10, -4.95}, {0.15, 10, -4.65})});
+  Scene post =
+      ray_cast(post_cam, {{{{0, 0, -6}, {0, 0, 1}}}, box({-0.15, -10, -4.95}, {0.15, 10, -4.65})});
   const auto wall_near_post = [&](int x, int y) {
     const size_t i = size_t(y) * post.width + x;
-    return post.depth[i] > 5.9f && std::fabs(post.point[i].x) < 0.7 && y > 4 &&
-           y < post.height - 4;
+    return post.depth[i] > 5.9f && std::fabs(post.point[i].x) < 0.7 && y > 4 && y < post.height - 4;
   };
   const Stats halo =
       stats_over(post, layered_ao(post, post_cam, true, true, "full", "horizon"), wall_near_post);

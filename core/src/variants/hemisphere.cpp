@@ -79,10 +79,9 @@ HWY_INLINE auto project_to_pixel(const CameraIntrinsics& cam, int width, int hei
     u = hn::MulAdd(x * inv, inv_scale_u, center_u);
     v = hn::NegMulAdd(y * inv, inv_scale_v, center_v);
   }
-  in_image = hn::And(in_image,
-                     hn::And(hn::And(hn::Ge(u, zero), hn::Ge(v, zero)),
-                             hn::And(hn::Lt(u, hn::Set(df, float(width))),
-                                     hn::Lt(v, hn::Set(df, float(height))))));
+  in_image = hn::And(in_image, hn::And(hn::And(hn::Ge(u, zero), hn::Ge(v, zero)),
+                                       hn::And(hn::Lt(u, hn::Set(df, float(width))),
+                                               hn::Lt(v, hn::Set(df, float(height))))));
   qx = hn::ConvertTo(di, hn::IfThenElseZero(in_image, u));
   qy = hn::ConvertTo(di, hn::IfThenElseZero(in_image, v));
   return in_image;
@@ -108,7 +107,8 @@ HWY_INLINE VF crossing_lanes(const HemisphereRowArgs& a, M candidate, VF ax, VF 
   const VF px = hn::MulAdd(bx - ax, t, ax), py = hn::MulAdd(by - ay, t, ay),
            pz = hn::MulAdd(bz - az, t, az);
   hn::Vec<decltype(di)> qx, qy;
-  const auto lanes = hn::And(candidate, project_to_pixel(cam, a.width, a.height, px, py, pz, qx, qy));
+  const auto lanes =
+      hn::And(candidate, project_to_pixel(cam, a.width, a.height, px, py, pz, qx, qy));
   if (hn::AllFalse(df, lanes)) return zero;
   // (qx, qy) are 0 on lanes outside the image: every index is in the plane.
   const VF depth = hn::GatherIndex(df, a.depth, qy * hn::Set(di, a.width) + qx);
@@ -227,7 +227,8 @@ HWY_INLINE void hemisphere_row_of(const HemisphereRowArgs& a, int y, int x0, int
         const VF sy = hn::MulAdd(ty, ox, hn::MulAdd(by, oy, hn::MulAdd(ny, oz, py)));
         const VF sz = hn::MulAdd(tz, ox, hn::MulAdd(bz, oy, hn::MulAdd(nz, oz, pz)));
         VI qx = hn::Zero(di), qy = hn::Zero(di);
-        const auto in_image = hn::And(project_to_pixel(cam, a.width, a.height, sx, sy, sz, qx, qy), receiver);
+        const auto in_image =
+            hn::And(project_to_pixel(cam, a.width, a.height, sx, sy, sz, qx, qy), receiver);
         seen = hn::Or(seen, in_image);
         auto hidden = none;
         VF qxv = zero, qyv = zero, qzv = zero;
@@ -306,9 +307,9 @@ HWY_INLINE void hemisphere_row_of(const HemisphereRowArgs& a, int y, int x0, int
             const auto here = hn::And(hidden, flips(hnx, hny, hnz, hw));
             const VF cnx = hn::IfThenElse(here, hnx, pnx), cny = hn::IfThenElse(here, hny, pny),
                      cnz = hn::IfThenElse(here, hnz, pnz), cw = hn::IfThenElse(here, hw, pw);
-            const auto candidate = hn::And(
-                hn::And(hn::Or(here, previous_hidden), flips(cnx, cny, cnz, cw)),
-                hn::Lt(blocked, one));
+            const auto candidate =
+                hn::And(hn::And(hn::Or(here, previous_hidden), flips(cnx, cny, cnz, cw)),
+                        hn::Lt(blocked, one));
             if (!hn::AllFalse(df, candidate)) {
               blocked = hn::Max(
                   blocked, crossing_lanes(a, candidate, ax, ay, az, sx, sy, sz, cnx, cny, cnz, cw));
@@ -425,11 +426,10 @@ class Hemisphere final : public Variant {
 
   void estimate(const Frame& f, const Tile& t, float* visibility) const override {
     const HemisphereRowArgs args{
-        f.depth_plane(), f.normal_plane(),    f.layer_planes(),        f.extra_layers(),
-        f.width(),       f.height(),          f.camera().intrinsics(), radius_,
-        bias_ * radius_, thickness_,          crossing_tolerance_,     f.pixel_count(),
-        directions_,
-        steps_,          lane_offsets_.data()};
+        f.depth_plane(), f.normal_plane(), f.layer_planes(),        f.extra_layers(),
+        f.width(),       f.height(),       f.camera().intrinsics(), radius_,
+        bias_ * radius_, thickness_,       crossing_tolerance_,     f.pixel_count(),
+        directions_,     steps_,           lane_offsets_.data()};
     for (int y = t.y0; y < t.y1; ++y) {
       best_hemisphere_row()(args, y, t.x0, t.x1, visibility + f.index(t.x0, y));
     }
@@ -479,8 +479,8 @@ class Hemisphere final : public Variant {
               // Inside a solid that a back face closes, or within the assumed thickness, when
               // above the tangent plane.
               if (dot(q - p, normal) > min_height) {
-                blocked = std::max(
-                    blocked, closed ? 1.0f : thickness_weight(-sample.z - entry, thickness_));
+                blocked = std::max(blocked,
+                                   closed ? 1.0f : thickness_weight(-sample.z - entry, thickness_));
               }
             }
             // The crossing test (below) takes surfaces above the tangent plane only, as the
@@ -494,8 +494,9 @@ class Hemisphere final : public Variant {
         // is hidden behind, else that of the one the previous point was hidden behind.
         if (f.extra_layers() > 0 && blocked < 1.0f && (hidden || previous_hidden)) {
           const bool here = hidden && sides_differ(previous, sample, surface, surface_normal);
-          blocked = std::max(blocked, crossing(f, previous, sample, here ? surface : previous_surface,
-                                               here ? surface_normal : previous_normal));
+          blocked =
+              std::max(blocked, crossing(f, previous, sample, here ? surface : previous_surface,
+                                         here ? surface_normal : previous_normal));
         }
         previous = sample;
         previous_hidden = hidden;

@@ -185,8 +185,8 @@ class Horizon final : public Variant {
   // each the stretch of the ray from a front face to the back face that closes it, cut to the
   // sphere of `radius` around p. A front face followed by another front face is an open surface
   // (a card), taken as thin; a front face that nothing closes is taken `thickness` deep.
-  uint32_t solid_sectors(const Frame& f, int qx, int qy, Vec3 p, Vec3 n, float min_height,
-                         Vec3 e_n, Vec3 e_t) const {
+  uint32_t solid_sectors(const Frame& f, int qx, int qy, Vec3 p, Vec3 n, float min_height, Vec3 e_n,
+                         Vec3 e_t) const {
     const CameraModel& cam = f.camera();
     const float u = float(qx) + 0.5f, v = float(qy) + 0.5f;
     uint32_t bits = 0;
