@@ -52,47 +52,51 @@ namespace ssao {
 namespace HWY_NAMESPACE {
 namespace hn = hwy::HWY_NAMESPACE;
 
-// The pixel (qx, qy) that view-space points (x, y, z) project to, on the lanes where they fall
-// inside the image in front of the camera (pixel_of_sample in variant.h).
-template <class VF, class VI>
-HWY_INLINE auto project_to_pixel(const CameraIntrinsics& cam, int width, int height, VF x, VF y,
-                                 VF z, VI& qx, VI& qy) {
-  namespace hn = hwy::HWY_NAMESPACE;
-  const hn::DFromV<VF> df;
-  const hn::RebindToSigned<decltype(df)> di;
-  const VF zero = hn::Zero(df), one = hn::Set(df, 1.0f);
-  const VF center_u = hn::Set(df, cam.center_u), center_v = hn::Set(df, cam.center_v);
-  const VF inv_scale_u = hn::Set(df, 1.0f / cam.scale_u),
-           inv_scale_v = hn::Set(df, 1.0f / cam.scale_v);
-  VF u, v;
-  auto in_image = hn::Gt(hn::Neg(z), zero);
-  if (cam.orthographic) {
-    u = hn::MulAdd(x, inv_scale_u, center_u);
-    v = hn::NegMulAdd(y, inv_scale_v, center_v);
-    in_image = hn::Lt(zero, one);  // all true
-  } else {
-    // 1 / depth: the hardware estimate refined by one Newton step (relative error below
-    // 1e-7, as a division's, at a fraction of its cost).
-    const VF depth = hn::Neg(z);
-    const VF estimate = hn::ApproximateReciprocal(depth);
-    const VF inv = estimate * hn::NegMulAdd(depth, estimate, hn::Set(df, 2.0f));
-    u = hn::MulAdd(x * inv, inv_scale_u, center_u);
-    v = hn::NegMulAdd(y * inv, inv_scale_v, center_v);
+// CameraModel::project on lanes, its constants broadcast once per row: continuous image
+// coordinates (u, v) of view-space points (x, y, z), and the lanes where they fall inside the
+// image in front of the camera (pixel_of_sample in variant.h).
+template <class VF>
+struct LaneProjection {
+  bool orthographic;
+  VF center_u, center_v, inv_scale_u, inv_scale_v, width, height;
+  LaneProjection(const CameraIntrinsics& cam, int width_px, int height_px) {
+    namespace hn = hwy::HWY_NAMESPACE;
+    const hn::DFromV<VF> df;
+    orthographic = cam.orthographic;
+    center_u = hn::Set(df, cam.center_u), center_v = hn::Set(df, cam.center_v);
+    inv_scale_u = hn::Set(df, 1.0f / cam.scale_u), inv_scale_v = hn::Set(df, 1.0f / cam.scale_v);
+    width = hn::Set(df, float(width_px)), height = hn::Set(df, float(height_px));
   }
-  in_image = hn::And(in_image, hn::And(hn::And(hn::Ge(u, zero), hn::Ge(v, zero)),
-                                       hn::And(hn::Lt(u, hn::Set(df, float(width))),
-                                               hn::Lt(v, hn::Set(df, float(height))))));
-  qx = hn::ConvertTo(di, hn::IfThenElseZero(in_image, u));
-  qy = hn::ConvertTo(di, hn::IfThenElseZero(in_image, v));
-  return in_image;
-}
+  HWY_INLINE auto operator()(VF x, VF y, VF z, VF& u, VF& v) const {
+    namespace hn = hwy::HWY_NAMESPACE;
+    const hn::DFromV<VF> df;
+    const VF zero = hn::Zero(df), one = hn::Set(df, 1.0f);
+    auto in_image = hn::Gt(hn::Neg(z), zero);
+    if (orthographic) {
+      u = hn::MulAdd(x, inv_scale_u, center_u);
+      v = hn::NegMulAdd(y, inv_scale_v, center_v);
+      in_image = hn::Lt(zero, one);  // all true
+    } else {
+      // 1 / depth: the hardware estimate refined by one Newton step (relative error below
+      // 1e-7, as a division's, at a fraction of its cost).
+      const VF depth = hn::Neg(z);
+      const VF estimate = hn::ApproximateReciprocal(depth);
+      const VF inv = estimate * hn::NegMulAdd(depth, estimate, hn::Set(df, 2.0f));
+      u = hn::MulAdd(x * inv, inv_scale_u, center_u);
+      v = hn::NegMulAdd(y * inv, inv_scale_v, center_v);
+    }
+    return hn::And(in_image, hn::And(hn::And(hn::Ge(u, zero), hn::Ge(v, zero)),
+                                     hn::And(hn::Lt(u, width), hn::Lt(v, height))));
+  }
+};
 
 // Hemisphere::crossing on the lanes of `candidate`, whose points a and b lie on either side of
 // the plane dot(x, c) = w: 1 where the depth image shows the plane, or something in front of
 // it, at the point where the segment meets the plane.
 template <class M, class VF>
-HWY_INLINE VF crossing_lanes(const HemisphereRowArgs& a, M candidate, VF ax, VF ay, VF az, VF bx,
-                             VF by, VF bz, VF cx, VF cy, VF cz, VF w) {
+HWY_INLINE VF crossing_lanes(const HemisphereRowArgs& a, const LaneProjection<VF>& project,
+                             M candidate, VF ax, VF ay, VF az, VF bx, VF by, VF bz, VF cx, VF cy,
+                             VF cz, VF w) {
   namespace hn = hwy::HWY_NAMESPACE;
   const hn::DFromV<VF> df;
   const hn::RebindToSigned<decltype(df)> di;
@@ -106,10 +110,11 @@ HWY_INLINE VF crossing_lanes(const HemisphereRowArgs& a, M candidate, VF ax, VF 
   const VF t = side_a * (estimate * hn::NegMulAdd(span, estimate, hn::Set(df, 2.0f)));
   const VF px = hn::MulAdd(bx - ax, t, ax), py = hn::MulAdd(by - ay, t, ay),
            pz = hn::MulAdd(bz - az, t, az);
-  hn::Vec<decltype(di)> qx, qy;
-  const auto lanes =
-      hn::And(candidate, project_to_pixel(cam, a.width, a.height, px, py, pz, qx, qy));
+  VF cu, cv;
+  const auto lanes = hn::And(candidate, project(px, py, pz, cu, cv));
   if (hn::AllFalse(df, lanes)) return zero;
+  const auto qx = hn::ConvertTo(di, hn::IfThenElseZero(lanes, cu));
+  const auto qy = hn::ConvertTo(di, hn::IfThenElseZero(lanes, cv));
   // (qx, qy) are 0 on lanes outside the image: every index is in the plane.
   const VF depth = hn::GatherIndex(df, a.depth, qy * hn::Set(di, a.width) + qx);
   // The plane meets the ray through that pixel's centre, origin o + depth * direction r, at
@@ -137,7 +142,7 @@ HWY_INLINE VF crossing_lanes(const HemisphereRowArgs& a, M candidate, VF ax, VF 
 // Visibility of pixels [x0, x1) of row y into out[0 .. x1 - x0); kLayers: the frame has extra
 // depth layers (compiled apart, so that the one-layer loop carries none of their state).
 template <bool kLayers>
-HWY_INLINE void hemisphere_row_of(const HemisphereRowArgs& a, int y, int x0, int x1, float* out) {
+HWY_NOINLINE void hemisphere_row_of(const HemisphereRowArgs& a, int y, int x0, int x1, float* out) {
   const hn::ScalableTag<float> df;
   const hn::RebindToSigned<decltype(df)> di;
   using VF = hn::Vec<decltype(df)>;
@@ -155,6 +160,7 @@ HWY_INLINE void hemisphere_row_of(const HemisphereRowArgs& a, int y, int x0, int
   const VF center_u = hn::Set(df, cam.center_u), center_v = hn::Set(df, cam.center_v);
   const VF inv_thickness = hn::Set(df, 1.0f / a.thickness);
   const VF radius = hn::Set(df, a.radius);
+  const LaneProjection<VF> project(cam, a.width, a.height);
   // Vectors start at x0 + a multiple of `lanes` (itself a multiple of 4): one phase.
   const float* row_offsets =
       a.lane_offsets + size_t(y & 3) * a.directions * a.steps * 3 * kLaneTable + (x0 & 3);
@@ -226,24 +232,42 @@ HWY_INLINE void hemisphere_row_of(const HemisphereRowArgs& a, int y, int x0, int
         const VF sx = hn::MulAdd(tx, ox, hn::MulAdd(bx, oy, hn::MulAdd(nx, oz, px)));
         const VF sy = hn::MulAdd(ty, ox, hn::MulAdd(by, oy, hn::MulAdd(ny, oz, py)));
         const VF sz = hn::MulAdd(tz, ox, hn::MulAdd(bz, oy, hn::MulAdd(nz, oz, pz)));
-        VI qx = hn::Zero(di), qy = hn::Zero(di);
-        const auto in_image =
-            hn::And(project_to_pixel(cam, a.width, a.height, sx, sy, sz, qx, qy), receiver);
+        VF su, sv;
+        const auto in_image = hn::And(project(sx, sy, sz, su, sv), receiver);
         seen = hn::Or(seen, in_image);
-        auto hidden = none;
-        VF qxv = zero, qyv = zero, qzv = zero;
-        VI index = hn::Zero(di);
-        if (!hn::AllFalse(df, in_image)) {
-          index = qy * hn::Set(di, a.width) + qx;
-          const VF qd = hn::GatherIndex(df, a.depth, index);
-          // The visible surface at that pixel (Frame::position).
+        if constexpr (!kLayers) {
+          if (hn::AllFalse(df, in_image)) continue;
+          const VI qx = hn::ConvertTo(di, hn::IfThenElseZero(in_image, su));
+          const VI qy = hn::ConvertTo(di, hn::IfThenElseZero(in_image, sv));
+          const VF qd = hn::GatherIndex(df, a.depth, qy * hn::Set(di, a.width) + qx);
+          // The visible surface at that pixel (Frame::position), occluding within the assumed
+          // thickness when above the tangent plane.
           const VF q_scale = cam.orthographic ? one : qd;
-          qxv = hn::MulAdd(hn::ConvertTo(df, qx), scale_u, pixel_u0) * q_scale;
-          qyv = hn::NegMulAdd(hn::ConvertTo(df, qy), scale_v, pixel_v0) * q_scale;
-          qzv = hn::Neg(qd);
+          const VF qxv = hn::MulAdd(hn::ConvertTo(df, qx), scale_u, pixel_u0) * q_scale;
+          const VF qyv = hn::NegMulAdd(hn::ConvertTo(df, qy), scale_v, pixel_v0) * q_scale;
+          const VF qzv = hn::Neg(qd);
           const VF behind = qzv - sz;  // > 0: the visible surface is in front of the sample
-          hidden = hn::And(hn::And(in_image, hn::Lt(qd, inf)), hn::Gt(behind, zero));
-          if constexpr (kLayers) {
+          const VF level = hn::MulAdd(qxv, nx, hn::MulAdd(qyv, ny, qzv * nz));
+          const auto counts = hn::And(hn::And(in_image, hn::Lt(qd, inf)),
+                                      hn::And(hn::Gt(behind, zero), hn::Gt(level, plane_level)));
+          const VF weight = hn::Min(one, hn::Max(zero, two - behind * inv_thickness));
+          blocked = hn::Max(blocked, hn::IfThenElseZero(counts, weight));
+        } else {
+          const VI qx = hn::ConvertTo(di, hn::IfThenElseZero(in_image, su));
+          const VI qy = hn::ConvertTo(di, hn::IfThenElseZero(in_image, sv));
+          auto hidden = none;
+          VF qxv = zero, qyv = zero, qzv = zero;
+          VI index = hn::Zero(di);
+          if (!hn::AllFalse(df, in_image)) {
+            index = qy * hn::Set(di, a.width) + qx;
+            const VF qd = hn::GatherIndex(df, a.depth, index);
+            // The visible surface at that pixel (Frame::position).
+            const VF q_scale = cam.orthographic ? one : qd;
+            qxv = hn::MulAdd(hn::ConvertTo(df, qx), scale_u, pixel_u0) * q_scale;
+            qyv = hn::NegMulAdd(hn::ConvertTo(df, qy), scale_v, pixel_v0) * q_scale;
+            qzv = hn::Neg(qd);
+            const VF behind = qzv - sz;  // > 0: the visible surface is in front of the sample
+            hidden = hn::And(hn::And(in_image, hn::Lt(qd, inf)), hn::Gt(behind, zero));
             if (!hn::AllFalse(df, hidden)) {
               // Frame::solid_entry on the lanes: walk the hits behind the visible one until the
               // one the sample lies in front of.
@@ -278,14 +302,7 @@ HWY_INLINE void hemisphere_row_of(const HemisphereRowArgs& a, int y, int x0, int
               const VF weight = hn::IfThenElse(closed, one, thick);
               blocked = hn::Max(blocked, hn::IfThenElseZero(counts, weight));
             }
-          } else {
-            const VF level = hn::MulAdd(qxv, nx, hn::MulAdd(qyv, ny, qzv * nz));
-            const auto counts = hn::And(hidden, hn::Gt(level, plane_level));
-            const VF weight = hn::Min(one, hn::Max(zero, two - behind * inv_thickness));
-            blocked = hn::Max(blocked, hn::IfThenElseZero(counts, weight));
           }
-        }
-        if constexpr (kLayers) {
           // Between the previous point and this one the direction may have passed through a
           // surface that neither lies in (a 2 cm board between two steps): the plane of the
           // surface this sample is hidden behind, else the previous point's (Hemisphere::pixel);
@@ -311,8 +328,8 @@ HWY_INLINE void hemisphere_row_of(const HemisphereRowArgs& a, int y, int x0, int
                 hn::And(hn::And(hn::Or(here, previous_hidden), flips(cnx, cny, cnz, cw)),
                         hn::Lt(blocked, one));
             if (!hn::AllFalse(df, candidate)) {
-              blocked = hn::Max(
-                  blocked, crossing_lanes(a, candidate, ax, ay, az, sx, sy, sz, cnx, cny, cnz, cw));
+              blocked = hn::Max(blocked, crossing_lanes(a, project, candidate, ax, ay, az, sx, sy,
+                                                        sz, cnx, cny, cnz, cw));
             }
           }
           ax = sx, ay = sy, az = sz;
