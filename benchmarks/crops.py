@@ -11,7 +11,7 @@ and Cycles' AO pass at 16 spp when the benchmark's sweep has it. Called by speed
 
     /usr/bin/python3 benchmarks/crops.py [--kit build/benchmark_kit] [--out crops.png]
         [--eval build/bin/ssao_eval] [--cycles build/benchmark/cycles] [--size 640x360]
-        [--baseline-lib DIR]   (adds the default of the libssao.so in DIR: before/after)
+        [--scenes a,b] [--baseline-lib DIR]   (DIR's libssao.so too: before/after)
 """
 import argparse
 import glob
@@ -139,7 +139,7 @@ def write_crops(args, path):
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
     scenes = []
-    for scene in SCENES:
+    for scene in getattr(args, "scenes", None) or SCENES:
         result = scene_columns(args, scene)
         if result is not None:
             scenes.append((scene, *result))
@@ -178,6 +178,8 @@ def main():
     parser.add_argument("--cycles", default=os.path.join(REPO_ROOT, "build", "benchmark", "cycles"))
     parser.add_argument("--size", default="640x360", metavar="WxH",
                         help="the kit's frame size to crop (default 640x360)")
+    parser.add_argument("--scenes", default=None, type=lambda text: text.split(","),
+                        help="comma-separated scenes (default: %s)" % ",".join(SCENES))
     parser.add_argument("--baseline-lib", default=None, metavar="DIR",
                         help="folder of another libssao.so whose default is shown too")
     args = parser.parse_args()
