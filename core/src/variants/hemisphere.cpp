@@ -52,13 +52,13 @@ namespace ssao {
 namespace HWY_NAMESPACE {
 namespace hn = hwy::HWY_NAMESPACE;
 
-// CameraModel::project on lanes, its constants broadcast once per row: continuous image
-// coordinates (u, v) of view-space points (x, y, z), and the lanes where they fall inside the
-// image in front of the camera (pixel_of_sample in variant.h).
+// The camera model on lanes, its constants broadcast once per row: CameraModel::project (the
+// call operator) and the rays through pixel centres (pixel_ray).
 template <class VF>
 struct LaneProjection {
   bool orthographic;
   VF center_u, center_v, inv_scale_u, inv_scale_v, width, height;
+  VF scale_u, scale_v, pixel_u0, pixel_v0;
   LaneProjection(const CameraIntrinsics& cam, int width_px, int height_px) {
     namespace hn = hwy::HWY_NAMESPACE;
     const hn::DFromV<VF> df;
@@ -66,7 +66,23 @@ struct LaneProjection {
     center_u = hn::Set(df, cam.center_u), center_v = hn::Set(df, cam.center_v);
     inv_scale_u = hn::Set(df, 1.0f / cam.scale_u), inv_scale_v = hn::Set(df, 1.0f / cam.scale_v);
     width = hn::Set(df, float(width_px)), height = hn::Set(df, float(height_px));
+    scale_u = hn::Set(df, cam.scale_u), scale_v = hn::Set(df, cam.scale_v);
+    // View x of pixel column qx at unit depth is qx * scale_u + pixel_u0 (its centre), view y
+    // of row qy is pixel_v0 - qy * scale_v.
+    pixel_u0 = hn::Set(df, (0.5f - cam.center_u) * cam.scale_u);
+    pixel_v0 = hn::Set(df, (cam.center_v - 0.5f) * cam.scale_v);
   }
+  // View x and y of the centre of pixel (qx, qy) at unit planar depth (perspective: the ray's
+  // direction, z = -1) or at any depth (orthographic).
+  template <class VI>
+  HWY_INLINE void pixel_ray(VI qx, VI qy, VF& x, VF& y) const {
+    namespace hn = hwy::HWY_NAMESPACE;
+    const hn::DFromV<VF> df;
+    x = hn::MulAdd(hn::ConvertTo(df, qx), scale_u, pixel_u0);
+    y = hn::NegMulAdd(hn::ConvertTo(df, qy), scale_v, pixel_v0);
+  }
+  // Continuous image coordinates (u, v) of view-space points (x, y, z), and the lanes where they
+  // fall inside the image in front of the camera (pixel_of_sample in variant.h).
   HWY_INLINE auto operator()(VF x, VF y, VF z, VF& u, VF& v) const {
     namespace hn = hwy::HWY_NAMESPACE;
     const hn::DFromV<VF> df;
@@ -120,10 +136,8 @@ HWY_INLINE VF crossing_lanes(const HemisphereRowArgs& a, const LaneProjection<VF
   // The plane meets the ray through that pixel's centre, origin o + depth * direction r, at
   // depth numerator / slope; the surface shown there is on or in front of it when
   // depth * slope <= numerator + tolerance * slope (slope > 0; both sides negated otherwise).
-  const VF u = hn::MulAdd(hn::ConvertTo(df, qx), hn::Set(df, cam.scale_u),
-                          hn::Set(df, (0.5f - cam.center_u) * cam.scale_u));
-  const VF v = hn::NegMulAdd(hn::ConvertTo(df, qy), hn::Set(df, cam.scale_v),
-                             hn::Set(df, (cam.center_v - 0.5f) * cam.scale_v));
+  VF u, v;
+  project.pixel_ray(qx, qy, u, v);
   VF numerator = w, slope = hn::Neg(cz);  // orthographic: o = (u, v, 0), r = (0, 0, -1)
   if (cam.orthographic) {
     numerator = w - hn::MulAdd(u, cx, v * cy);
@@ -152,10 +166,6 @@ HWY_NOINLINE void hemisphere_row_of(const HemisphereRowArgs& a, int y, int x0, i
   const VF inf = hn::Set(df, std::numeric_limits<float>::infinity());
   const VF zero = hn::Zero(df), one = hn::Set(df, 1.0f), half = hn::Set(df, 0.5f);
   const VF two = hn::Set(df, 2.0f);
-  // View x of pixel column qx at unit depth is qx * scale_u + pixel_u0 (its centre), view y of
-  // row qy is pixel_v0 - qy * scale_v.
-  const VF pixel_u0 = hn::Set(df, (0.5f - cam.center_u) * cam.scale_u);
-  const VF pixel_v0 = hn::Set(df, (cam.center_v - 0.5f) * cam.scale_v);
   const VF scale_u = hn::Set(df, cam.scale_u), scale_v = hn::Set(df, cam.scale_v);
   const VF center_u = hn::Set(df, cam.center_u), center_v = hn::Set(df, cam.center_v);
   const VF inv_thickness = hn::Set(df, 1.0f / a.thickness);
@@ -243,8 +253,9 @@ HWY_NOINLINE void hemisphere_row_of(const HemisphereRowArgs& a, int y, int x0, i
           // The visible surface at that pixel (Frame::position), occluding within the assumed
           // thickness when above the tangent plane.
           const VF q_scale = cam.orthographic ? one : qd;
-          const VF qxv = hn::MulAdd(hn::ConvertTo(df, qx), scale_u, pixel_u0) * q_scale;
-          const VF qyv = hn::NegMulAdd(hn::ConvertTo(df, qy), scale_v, pixel_v0) * q_scale;
+          VF ray_x, ray_y;
+          project.pixel_ray(qx, qy, ray_x, ray_y);
+          const VF qxv = ray_x * q_scale, qyv = ray_y * q_scale;
           const VF qzv = hn::Neg(qd);
           const VF behind = qzv - sz;  // > 0: the visible surface is in front of the sample
           const VF level = hn::MulAdd(qxv, nx, hn::MulAdd(qyv, ny, qzv * nz));
@@ -263,8 +274,9 @@ HWY_NOINLINE void hemisphere_row_of(const HemisphereRowArgs& a, int y, int x0, i
             const VF qd = hn::GatherIndex(df, a.depth, index);
             // The visible surface at that pixel (Frame::position).
             const VF q_scale = cam.orthographic ? one : qd;
-            qxv = hn::MulAdd(hn::ConvertTo(df, qx), scale_u, pixel_u0) * q_scale;
-            qyv = hn::NegMulAdd(hn::ConvertTo(df, qy), scale_v, pixel_v0) * q_scale;
+            VF ray_x, ray_y;  // of this pixel, for the visible surface and the one entered
+            project.pixel_ray(qx, qy, ray_x, ray_y);
+            qxv = ray_x * q_scale, qyv = ray_y * q_scale;
             qzv = hn::Neg(qd);
             const VF behind = qzv - sz;  // > 0: the visible surface is in front of the sample
             hidden = hn::And(hn::And(in_image, hn::Lt(qd, inf)), hn::Gt(behind, zero));
@@ -292,8 +304,7 @@ HWY_NOINLINE void hemisphere_row_of(const HemisphereRowArgs& a, int y, int x0, i
               // else within the assumed thickness), when that surface is above the tangent
               // plane.
               const VF entry_scale = cam.orthographic ? one : entry;
-              const VF ex = hn::MulAdd(hn::ConvertTo(df, qx), scale_u, pixel_u0) * entry_scale;
-              const VF ey = hn::NegMulAdd(hn::ConvertTo(df, qy), scale_v, pixel_v0) * entry_scale;
+              const VF ex = ray_x * entry_scale, ey = ray_y * entry_scale;
               const VF entry_level = hn::MulAdd(ex, nx, hn::MulAdd(ey, ny, hn::Neg(entry) * nz));
               const auto counts =
                   hn::And(hn::And(hidden, entered), hn::Gt(entry_level, plane_level));
