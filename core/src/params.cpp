@@ -81,8 +81,9 @@ const std::vector<Param>& params() {
                 "horizon: screen-space lines through each pixel; 0: from quality"),
       int_param(kQuality, "steps", 0, 0, 64, "samples per direction",
                 "hemisphere: samples along each direction, the strongest occluder counts (1 is "
-                "the classic kernel of independent points); horizon: samples on each side of a "
-                "slice; 0: from quality"),
+                "the classic kernel of independent points; 0: from quality, twice the preset's "
+                "with extra depth layers); horizon: samples on each side of a slice; 0: from "
+                "quality"),
       float_param(kAo, "bias", 0.02, 0.0, 1.0, "fraction of radius",
                   "height above the receiver's tangent plane (hemisphere, horizon) or behind the "
                   "sample (sphere) an occluder needs to count; one pixel footprint is added"),

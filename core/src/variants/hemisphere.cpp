@@ -390,9 +390,13 @@ decltype(&HWY_STATIC_DISPATCH(hemisphere_row)) best_hemisphere_row() {
 
 class Hemisphere final : public Variant {
  public:
-  explicit Hemisphere(const ParamValues& v) {
+  Hemisphere(const ParamValues& v, const Frame& f) {
     static constexpr int kSamples[4] = {4, 4, 8, 16};
     static constexpr int kSteps[4] = {4, 6, 6, 6};
+    // With extra depth layers a sample behind a solid's back face is free space, so a solid
+    // counts only where a step lands inside it or the crossing test catches the segment: twice
+    // the steps halve the gap a thin board can fall into (docs/variants.md, issue 31).
+    static constexpr int kLayeredSteps[4] = {8, 12, 12, 12};
     radius_ = float(v.get_float("radius"));
     bias_ = float(v.get_float("bias"));
     thickness_ = float(v.get_float("thickness")) * radius_;
@@ -400,7 +404,7 @@ class Hemisphere final : public Variant {
     // and still have it taken as that surface (tangent planes of curved surfaces drift).
     crossing_tolerance_ = 0.25f * thickness_;
     directions_ = count_or_preset(v, "samples", kSamples);
-    steps_ = count_or_preset(v, "steps", kSteps);
+    steps_ = count_or_preset(v, "steps", f.extra_layers() > 0 ? kLayeredSteps : kSteps);
     // Each kernel direction is followed by `steps` samples at increasing distances;
     // steps = 1 is the classic kernel of independent points. The table holds, per jitter
     // state, every sample's offset in the receiver's tangent frame, rotated and scaled.
@@ -577,8 +581,8 @@ const VariantInfo kHemisphereVariant = {
     "normal-oriented hemisphere kernel: directions cosine-weighted about the normal, each "
     "marched in steps",
     "samples|steps|sample_clustering|thickness|bias|seed",
-    [](const ParamValues& v, const Frame&) -> std::unique_ptr<Variant> {
-      return std::make_unique<Hemisphere>(v);
+    [](const ParamValues& v, const Frame& f) -> std::unique_ptr<Variant> {
+      return std::make_unique<Hemisphere>(v, f);
     }};
 
 }  // namespace ssao
