@@ -140,9 +140,16 @@ TEST(Layers, ThinBoardOverAWallIsNoLighterWithLayers) {
   // its level: the camera sees the wall under it and the board's underside; above the board is
   // open. A point sample rarely lands inside the board, and with layers a sample above it is
   // free space behind its back face: the steps must see the board between them
-  // (Hemisphere::crossing).
-  Camera cam;
-  cam.width = 128, cam.height = 128;
+  // (Hemisphere::crossing). The frame is rendered with a guard band and scored inside it (the
+  // AO of an output window: OverscanWithLayersEqualsTheWidenedFrameCropped), as the layers are
+  // used: without it the samples above the board leave the top of a 128 px frame and both
+  // readings are +0.05 too light for that reason alone.
+  constexpr int kBand = 96;
+  Camera frame;
+  frame.width = 128, frame.height = 128;
+  Camera cam = frame;
+  cam.width += 2 * kBand, cam.height += 2 * kBand;
+  cam.sensor = frame.sensor * cam.width / frame.width;
   const double wall_z = -2.0, board_y = 0.4, thickness = 0.02;
   const std::vector<Solid> solids = {
       {{{0, 0, wall_z}, {0, 0, 1}}},
@@ -150,8 +157,8 @@ TEST(Layers, ThinBoardOverAWallIsNoLighterWithLayers) {
   Scene s = ray_cast(cam, solids);
   std::vector<size_t> pixels;
   std::vector<double> reference;
-  for (int y = 4; y < s.height - 4; ++y) {
-    for (int x = 4; x < s.width - 4; ++x) {
+  for (int y = kBand + 4; y < s.height - kBand - 4; ++y) {
+    for (int x = kBand + 4; x < s.width - kBand - 4; ++x) {
       const size_t i = size_t(y) * s.width + x;
       const V3 p = s.point[i];
       // The wall within 0.6 below the board.
@@ -160,25 +167,32 @@ TEST(Layers, ThinBoardOverAWallIsNoLighterWithLayers) {
         continue;
       }
       pixels.push_back(i);
-      reference.push_back(ray_traced_ao(solids, p, {0, 0, 1}, kRadius, 256));
+      // 1024 rays: the reference's own noise (0.014 RMS at AO 0.7) stays below the errors.
+      reference.push_back(ray_traced_ao(solids, p, {0, 0, 1}, kRadius, 1024));
     }
   }
   ASSERT_GT(pixels.size(), 500u);
   const Error one = error_against(layered_ao(s, cam, false), reference, pixels);
   const Error three = error_against(layered_ao(s, cam, true), reference, pixels);
+  const Error three_6 =
+      error_against(layered_ao(s, cam, true, true, "full", "hemisphere", 6), reference, pixels);
   double mean_reference = 0;
   for (double r : reference) mean_reference += r / double(reference.size());
   std::printf(
-      "[ measure  ] 2 cm board over a wall, %d wall px under it (ray-traced mean %.4f): "
-      "one layer RMSE %.4f bias %+.4f; 3 hits RMSE %.4f bias %+.4f\n",
-      one.count, mean_reference, one.rmse, one.bias, three.rmse, three.bias);
+      "[ measure  ] 2 cm board over a wall, %d wall px under it (ray-traced mean %.4f), %d px "
+      "band: one layer RMSE %.4f bias %+.4f; 3 hits RMSE %.4f bias %+.4f (4 x 6 steps: %.4f "
+      "%+.4f)\n",
+      one.count, mean_reference, kBand, one.rmse, one.bias, three.rmse, three.bias, three_6.rmse,
+      three_6.bias);
   EXPECT_LT(mean_reference, 0.8);  // the board occludes: the test measures something
-  // Without the crossing test the layers read this wall far too light (RMSE 0.140, bias
-  // +0.121, against 0.071 / +0.054 with one layer; with it 0.075 / +0.058). What is left is
-  // shared with one layer: steps on either side of the board, both in open air (the camera
-  // sees the wall above the board past its front edge), cannot see it.
-  EXPECT_LE(three.rmse, one.rmse + 0.01);
-  EXPECT_LT(three.bias, 0.07);
+  // Without the crossing test the layers read this wall far too light (RMSE 0.140, bias +0.121
+  // without the band). With it the board is seen; the crossing is caught once per direction, at
+  // the pair of steps around the board, and missed where the upper step's pixel shows the wall
+  // next to the board's underside (seen edge-on near the wall), so the layers stay a little
+  // lighter than one layer, whose thickness rule counts every step above the board.
+  EXPECT_LE(three.rmse, one.rmse + 0.012);
+  EXPECT_LT(std::fabs(three.bias), 0.02);
+  EXPECT_LT(std::fabs(one.bias), 0.02);
 }
 
 TEST(Layers, HorizonReadsThemAsSolidsInItsSlices) {
@@ -384,3 +398,4 @@ TEST(Layers, LayersOfBackgroundPixelsAreNotRead) {
   EXPECT_EQ(f.run(), SSAO_OK) << ssao_last_error();
   for (int x = 0; x < SmallFrame::kSize; ++x) EXPECT_EQ(f.ao[size_t(x)], 1.0f);
 }
+
