@@ -127,8 +127,22 @@ class Frame {
   // +inf when it is in front of the visible surface or in free space behind a back face.
   // `closed`: a back face follows the point on the ray, so the point is inside the solid; else
   // nothing closes it and the caller assumes a thickness. Without extra layers: the visible
-  // surface's depth (closed = false) when the point is behind it.
-  float solid_entry(int x, int y, float depth, bool& closed) const;
+  // surface's depth (closed = false) when the point is behind it. `past_last` (optional): the
+  // point lies behind the ray's last known hit.
+  float solid_entry(int x, int y, float depth, bool& closed, bool* past_last = nullptr) const;
+
+  // With extra layers, per pixel: how deep the solid entered at the ray's last known hit is,
+  // when that hit is a front face hidden behind the visible surface and no later hit closes it
+  // (a column behind a fence post whose back would be hit 4), as measured where a neighbour
+  // within kThicknessSearch pixels sees a surface at that depth with its back face; 0 where
+  // nothing says (the caller's assumed thickness applies). Null without extra layers.
+  const float* last_thickness_plane() const {
+    return extra_layers_ > 0 ? last_thickness_.data() : nullptr;
+  }
+  float last_thickness(int x, int y) const {
+    return extra_layers_ > 0 ? last_thickness_[index(x, y)] : 0.0f;
+  }
+  static constexpr int kThicknessSearch = 8;
 
  private:
   Vec3 reconstructed_normal(int x, int y) const;
@@ -148,6 +162,14 @@ class Frame {
   void encode_normal_row(const float* rotation, float v, int x0, int count, const float* nx,
                          const float* ny, const float* nz, uint32_t* usable, uint32_t* out) const;
 
+  // Fills last_thickness_ from the finished depth and layer planes.
+  void infer_last_thickness(TilePool& pool, Progress& progress);
+  static void hidden_last_fronts(const float* layers, size_t plane, int extra_layers, int count,
+                                 float* last);
+  static bool search_step(const float* last, const float* visible, const float* layers,
+                          size_t plane, int extra_layers, int count, float tolerance,
+                          float* stopped, float* best);
+
   // Hit k of pixels [x0, x0 + count) of row y into its plane; `facing`: scratch of count floats.
   void layer_row(const FrameInputs& in, int k, int x0, int count, int y, float limit,
                  float* facing);
@@ -159,6 +181,7 @@ class Frame {
   std::vector<float> depth_;
   std::vector<uint32_t> normal_;
   std::vector<float> layers_;
+  std::vector<float> last_thickness_;
 };
 
 }  // namespace ssao

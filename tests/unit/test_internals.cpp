@@ -313,7 +313,8 @@ struct PreparedFrame {
 
 // A corner (two walls) on a floor: creases, silhouettes and open floor in one frame. 101 pixels
 // wide, so rows end in a partial vector on every SIMD width.
-// With `layers`, a box floats in front of the corner and the frame gets the 2nd and 3rd hits:
+// With `layers`, a box floats in front of the corner, a slab behind it, and the frame gets the
+// 2nd and 3rd hits:
 // `facing` says whether their facing images are given or taken to alternate.
 void prepare(PreparedFrame& out, const Camera& cam, const char* variant, bool layers = false,
              bool facing = true) {
@@ -323,7 +324,12 @@ void prepare(PreparedFrame& out, const Camera& cam, const char* variant, bool la
   std::vector<Solid> solids = {
       {{{0, -1.0, 0}, {0, 1, 0}}},
       {{{0.3, 0, -6}, normalized({1, 0, 1})}, {{0.3, 0, -6}, normalized({-1, 0, 1})}}};
-  if (layers) solids.push_back(box({-0.9, -0.8, -5.2}, {-0.1, 0.2, -4.6}));
+  if (layers) {
+    solids.push_back(box({-0.9, -0.8, -5.2}, {-0.1, 0.2, -4.6}));
+    // A thin slab behind the box that shows beside it: where the box hides it, its front is
+    // the 3rd hit and its thickness is measured beside the box (Frame::last_thickness).
+    solids.push_back(box({-0.6, -0.9, -5.6}, {0.2, 0.5, -5.5}));
+  }
   static Scene s;  // the frame's images must outlive build(): kept until the next prepare()
   s = ray_cast(c, solids);
   out.values.set_string("variant", variant);
@@ -366,6 +372,44 @@ std::vector<float> estimate(const PreparedFrame& p, bool reference,
 std::vector<ssao::Tile> whole(const ssao::Frame& f) { return {{0, 0, f.width(), f.height()}}; }
 
 }  // namespace
+
+TEST(Frame, LastThicknessIsMeasuredBesideTheForeground) {
+  // prepare()'s layered frame: where the floating box hides the 10 cm slab behind it, the slab's
+  // front is the last known hit; within kThicknessSearch pixels of where the slab shows, the
+  // slab's chord along a neighbour's ray is read there. The truth: the chord along the pixel's
+  // own ray, from a frame without the box (there the slab is the 1st hit and its back the 2nd).
+  Camera c;
+  c.width = 101, c.height = 67;
+  const Scene unhidden = ray_cast(c, {{{{0, -1.0, 0}, {0, 1, 0}}},
+                                      {{{0.3, 0, -6}, normalized({1, 0, 1})},
+                                       {{0.3, 0, -6}, normalized({-1, 0, 1})}},
+                                      box({-0.6, -0.9, -5.6}, {0.2, 0.5, -5.5})});
+  for (bool facing : {true, false}) {
+    PreparedFrame p;
+    prepare(p, c, "hemisphere", true, facing);
+    const ssao::Frame& f = p.frame;
+    int slab = 0, measured = 0, exact = 0;
+    for (int y = 0; y < f.height(); ++y) {
+      for (int x = 0; x < f.width(); ++x) {
+        const size_t i = f.index(x, y);
+        const float third = f.layer_planes()[f.pixel_count() + i];
+        if (std::fabs(third - 5.5f) > 1e-3f) continue;  // the slab's front as the 3rd hit
+        ++slab;
+        const float t = f.last_thickness(x, y);
+        if (!(t > 0.0f)) continue;
+        ++measured;
+        const float chord = unhidden.layer[0][i] - unhidden.depth[i];
+        exact += std::fabs(t - chord) <= 1e-3f ? 1 : 0;
+        EXPECT_LE(t, 0.1f + 1e-3f) << x << ", " << y << " chord " << chord;  // never more than the slab is deep
+      }
+    }
+    std::printf("[ measure  ] facing %s: slab hidden behind the box at %d px, its thickness "
+                "measured at %d, equal to its own chord at %d\n",
+                facing ? "given" : "alternating", slab, measured, exact);
+    EXPECT_GT(measured, slab / 2);
+    EXPECT_GE(exact, measured * 9 / 10);
+  }
+}
 
 TEST(FastPath, EveryVariantMatchesItsScalarReference) {
   struct Case {

@@ -182,7 +182,9 @@ SSAO_API ssao_status ssao_job_get_floats(ssao_job job, const char* name, double*
  *               are taken to alternate: the 2nd a back face, the 3rd a front face, ...
  *               A sample point counts as occluded inside a solid (behind a front face and in
  *               front of the back face that follows it); behind the last front face the ray
- *               knows, the "thickness" rule applies as with one layer. Variants that read the
+ *               knows, the "thickness" rule applies as with one layer, with that solid's own
+ *               thickness where a pixel nearby sees it whole (docs/variants.md, "Measured
+ *               thickness of hidden solids"). Variants that read the
  *               layers: "hemisphere" and "horizon" (docs/variants.md); the others ignore them.
  * All images of a job must have the depth image's width and height, unless an output window
  * is set (ssao_job_set_output_window). */

@@ -34,6 +34,7 @@ struct HemisphereRowArgs {
   const float* depth;       // the frame's depth plane
   const uint32_t* normals;  // the frame's packed normals
   const float* layers;      // the frame's extra depth layers (Frame::layer_planes)
+  const float* last_thickness;  // Frame::last_thickness_plane
   int extra_layers;
   int width, height;
   CameraIntrinsics camera;
@@ -288,17 +289,31 @@ HWY_NOINLINE void hemisphere_row_of(const HemisphereRowArgs& a, int y, int x0, i
               auto entered = hidden;  // the visible surface is a front face
               auto open = hidden;     // not yet placed between two hits
               auto closed = none;
+              auto past_last = none;  // behind the last hit the ray knows
               for (int layer = 0; layer < a.extra_layers; ++layer) {
                 const VF hit = hn::GatherIndex(df, a.layers + size_t(layer) * a.plane, index);
                 const VF hit_depth = hn::Abs(hit);
                 const auto back = hn::Lt(hit, zero);
                 const auto here = hn::And(open, hn::Le(sample_depth, hit_depth));
                 closed = hn::Or(closed, hn::And(here, hn::And(entered, back)));
+                past_last = hn::Or(past_last, hn::And(here, hn::Eq(hit, inf)));
                 const auto past = hn::AndNot(here, open);  // open lanes behind this hit
                 entry = hn::IfThenElse(past, hit_depth, entry);
                 entered = hn::Or(hn::AndNot(past, entered), hn::AndNot(back, past));
                 open = past;
                 if (hn::AllFalse(df, open)) break;
+              }
+              past_last = hn::Or(past_last, open);
+              // Behind the last known hit, a front face: the solid's thickness where the frame
+              // measured it beside the foreground (Frame::last_thickness), else the assumed one.
+              VF inv_depth_of_solid = inv_thickness;
+              const auto measured_lanes =
+                  hn::And(hn::And(past_last, entered), hn::AndNot(closed, hidden));
+              if (!hn::AllFalse(df, measured_lanes)) {
+                const VF measured = hn::GatherIndex(df, a.last_thickness, index);
+                const auto known = hn::And(measured_lanes, hn::Gt(measured, zero));
+                inv_depth_of_solid = hn::IfThenElse(
+                    known, one / hn::IfThenElse(known, measured, one), inv_thickness);
               }
               // Occluded by the solid entered at `entry` (inside it when a back face closes it,
               // else within the assumed thickness), when that surface is above the tangent
@@ -309,7 +324,7 @@ HWY_NOINLINE void hemisphere_row_of(const HemisphereRowArgs& a, int y, int x0, i
               const auto counts =
                   hn::And(hn::And(hidden, entered), hn::Gt(entry_level, plane_level));
               const VF thick =
-                  hn::Min(one, hn::Max(zero, two - (sample_depth - entry) * inv_thickness));
+                  hn::Min(one, hn::Max(zero, two - (sample_depth - entry) * inv_depth_of_solid));
               const VF weight = hn::IfThenElse(closed, one, thick);
               blocked = hn::Max(blocked, hn::IfThenElseZero(counts, weight));
             }
@@ -458,7 +473,8 @@ class Hemisphere final : public Variant {
 
   void estimate(const Frame& f, const Tile& t, float* visibility) const override {
     const HemisphereRowArgs args{
-        f.depth_plane(), f.normal_plane(), f.layer_planes(),        f.extra_layers(),
+        f.depth_plane(), f.normal_plane(), f.layer_planes(), f.last_thickness_plane(),
+        f.extra_layers(),
         f.width(),       f.height(),       f.camera().intrinsics(), radius_,
         bias_ * radius_, thickness_,       crossing_tolerance_,     f.pixel_count(),
         directions_,     steps_,           lane_offsets_.data()};
@@ -504,15 +520,19 @@ class Hemisphere final : public Variant {
             surface = f.position(qx, qy);
             hidden = -sample.z > -surface.z;
             // The surface the sample lies behind (the visible one without extra layers), if any.
-            bool closed = false;
-            const float entry = f.solid_entry(qx, qy, -sample.z, closed);
+            bool closed = false, past_last = false;
+            const float entry = f.solid_entry(qx, qy, -sample.z, closed, &past_last);
             if (entry != Frame::kBackground) {
               const Vec3 q = f.camera().view_position(float(qx) + 0.5f, float(qy) + 0.5f, entry);
-              // Inside a solid that a back face closes, or within the assumed thickness, when
-              // above the tangent plane.
+              // Inside a solid that a back face closes, or within its thickness (measured beside
+              // the foreground for a hidden last hit, else assumed), when above the tangent
+              // plane.
+              const float measured = past_last ? f.last_thickness(qx, qy) : 0.0f;
               if (dot(q - p, normal) > min_height) {
-                blocked = std::max(blocked,
-                                   closed ? 1.0f : thickness_weight(-sample.z - entry, thickness_));
+                blocked = std::max(
+                    blocked, closed ? 1.0f
+                                    : thickness_weight(-sample.z - entry,
+                                                       measured > 0.0f ? measured : thickness_));
               }
             }
             // The crossing test (below) takes surfaces above the tangent plane only, as the

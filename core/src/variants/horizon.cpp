@@ -184,7 +184,8 @@ class Horizon final : public Variant {
   // With extra depth layers: the sectors covered by the solids that pixel (qx, qy)'s ray crosses,
   // each the stretch of the ray from a front face to the back face that closes it, cut to the
   // sphere of `radius` around p. A front face followed by another front face is an open surface
-  // (a card), taken as thin; a front face that nothing closes is taken `thickness` deep.
+  // (a card), taken as thin; a front face that nothing closes is as deep as the frame measured
+  // it beside the foreground (Frame::last_thickness), else `thickness`.
   uint32_t solid_sectors(const Frame& f, int qx, int qy, Vec3 p, Vec3 n, float min_height, Vec3 e_n,
                          Vec3 e_t) const {
     const CameraModel& cam = f.camera();
@@ -226,7 +227,10 @@ class Horizon final : public Variant {
         inside = true;
       }
     }
-    if (inside) add(entry, entry + thickness_);
+    if (inside) {  // nothing closes the last front face: its measured depth, else assumed
+      const float measured = f.last_thickness(qx, qy);
+      add(entry, entry + (measured > 0.0f ? measured : thickness_));
+    }
     return bits;
   }
 
