@@ -156,6 +156,17 @@ inline Scene ray_cast(const Camera& cam, const std::vector<Solid>& solids) {
   return s;
 }
 
+// The frame's camera widened by `band` pixels on every side, on the same pixel grid (a guard
+// band's camera).
+inline Camera widened(const Camera& frame, int band) {
+  Camera big = frame;
+  big.width = frame.width + 2 * band;
+  big.height = frame.height + 2 * band;
+  big.sensor = frame.sensor * big.width / frame.width;  // horizontal fit: the sensor spans width
+  big.ortho_scale = frame.ortho_scale * big.width / frame.width;
+  return big;
+}
+
 // An axis-aligned box [lo, hi] as a solid.
 inline Solid box(V3 lo, V3 hi) {
   return {{lo, {-1, 0, 0}}, {lo, {0, -1, 0}}, {lo, {0, 0, -1}},

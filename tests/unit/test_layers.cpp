@@ -147,9 +147,7 @@ TEST(Layers, ThinBoardOverAWallIsNoLighterWithLayers) {
   constexpr int kBand = 96;
   Camera frame;
   frame.width = 128, frame.height = 128;
-  Camera cam = frame;
-  cam.width += 2 * kBand, cam.height += 2 * kBand;
-  cam.sensor = frame.sensor * cam.width / frame.width;
+  const Camera cam = widened(frame, kBand);
   const double wall_z = -2.0, board_y = 0.4, thickness = 0.02;
   const std::vector<Solid> solids = {
       {{{0, 0, wall_z}, {0, 0, 1}}},
@@ -270,9 +268,7 @@ TEST(Layers, OverscanWithLayersEqualsTheWidenedFrameCropped) {
   constexpr int kBand = 16;
   Camera frame;
   frame.width = 80, frame.height = 60;
-  Camera big_camera = frame;
-  big_camera.width += 2 * kBand, big_camera.height += 2 * kBand;
-  big_camera.sensor = frame.sensor * big_camera.width / frame.width;
+  const Camera big_camera = widened(frame, kBand);
   Scene big = ray_cast(big_camera, SphereOnFloor{}.solids());
   const auto whole = layered_ao(big, big_camera, true);
   Job job;

@@ -15,16 +15,6 @@ namespace {
 
 constexpr int kWidth = 96, kHeight = 64, kBand = 24;
 
-// The frame's camera widened by `band` pixels on every side, on the same pixel grid.
-Camera widened(const Camera& frame, int band) {
-  Camera big = frame;
-  big.width = frame.width + 2 * band;
-  big.height = frame.height + 2 * band;
-  big.sensor = frame.sensor * big.width / frame.width;  // horizontal fit: the sensor spans width
-  big.ortho_scale = frame.ortho_scale * big.width / frame.width;
-  return big;
-}
-
 // AO of the frame's window from the widened scene, through the output window.
 std::vector<float> windowed_ao(Scene& big, const Camera& frame, int band, double radius,
                                const char* variant, const char* resolution) {
