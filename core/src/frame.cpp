@@ -92,16 +92,17 @@ void Frame::infer_last_thickness(TilePool& pool, Progress& progress) {
 
 // The last known hit of each pixel when it is a front face behind the visible surface (> 0),
 // else 0. Hits are in order, background after the last one.
-SSAO_VECTORIZE void Frame::hidden_last_fronts(const float* layers, size_t plane,
-                                              int extra_layers, int count,
-                                              float* __restrict last) {
+SSAO_VECTORIZE void Frame::hidden_last_fronts(const float* layers, size_t plane, int extra_layers,
+                                              int count, float* __restrict last) {
   // One pass per hit and no branch, so that each loop vectorises.
   std::fill_n(last, count, kBackground);
   for (int k = 0; k < extra_layers; ++k) {
     const float* __restrict hits = layers + size_t(k) * plane;
     for (int i = 0; i < count; ++i) last[i] = hits[i] != kBackground ? hits[i] : last[i];
   }
-  for (int i = 0; i < count; ++i) last[i] = (last[i] > 0.0f) & (last[i] != kBackground) ? last[i] : 0.0f;
+  for (int i = 0; i < count; ++i) {
+    last[i] = ((last[i] > 0.0f) & (last[i] != kBackground)) ? last[i] : 0.0f;
+  }
 }
 
 // One step of the search for pixels [0, count) of a row, their neighbours' visible depths and
@@ -111,10 +112,9 @@ SSAO_VECTORIZE void Frame::hidden_last_fronts(const float* layers, size_t plane,
 // whose neighbour's ray meets no surface at its depth among its first three hits (the surface
 // ended: beyond lies another one). Returns whether any pixel walks on.
 SSAO_VECTORIZE bool Frame::search_step(const float* __restrict last,
-                                       const float* __restrict visible,
-                                       const float* layers, size_t plane, int extra_layers,
-                                       int count, float tolerance, float* __restrict stopped,
-                                       float* __restrict best) {
+                                       const float* __restrict visible, const float* layers,
+                                       size_t plane, int extra_layers, int count, float tolerance,
+                                       float* __restrict stopped, float* __restrict best) {
   // The neighbour's first three hits say whether the surface goes on (later ones rarely do).
   const float* __restrict second = layers;
   const float* __restrict third = layers + (extra_layers > 1 ? plane : 0);
@@ -123,13 +123,14 @@ SSAO_VECTORIZE bool Frame::search_step(const float* __restrict last,
     // & rather than &&: no branch, so the loop vectorises.
     const float reach = last[i] * tolerance;
     const bool on_visible = std::fabs(visible[i] - last[i]) <= reach;
-    const bool near = on_visible | (std::fabs(std::fabs(second[i]) - last[i]) <= reach) |
-                      (std::fabs(std::fabs(third[i]) - last[i]) <= reach);
+    const bool on_second = std::fabs(std::fabs(second[i]) - last[i]) <= reach;
+    const bool on_third = std::fabs(std::fabs(third[i]) - last[i]) <= reach;
+    const bool near = on_visible | on_second | on_third;
     const bool walking = (stopped[i] == 0.0f) & (last[i] > 0.0f) & near;
     const bool match = walking & on_visible & (visible[i] != kBackground) & (second[i] < 0.0f);
     const float thickness = -second[i] - visible[i];
     best[i] = match ? std::max(best[i], thickness) : best[i];
-    stopped[i] = walking & !match ? stopped[i] : 1.0f;
+    stopped[i] = (walking & !match) ? stopped[i] : 1.0f;
     walking_on |= int(walking & !match);
   }
   return walking_on != 0;

@@ -380,10 +380,10 @@ TEST(Frame, LastThicknessIsMeasuredBesideTheForeground) {
   // own ray, from a frame without the box (there the slab is the 1st hit and its back the 2nd).
   Camera c;
   c.width = 101, c.height = 67;
-  const Scene unhidden = ray_cast(c, {{{{0, -1.0, 0}, {0, 1, 0}}},
-                                      {{{0.3, 0, -6}, normalized({1, 0, 1})},
-                                       {{0.3, 0, -6}, normalized({-1, 0, 1})}},
-                                      box({-0.6, -0.9, -5.6}, {0.2, 0.5, -5.5})});
+  const Scene unhidden =
+      ray_cast(c, {{{{0, -1.0, 0}, {0, 1, 0}}},
+                   {{{0.3, 0, -6}, normalized({1, 0, 1})}, {{0.3, 0, -6}, normalized({-1, 0, 1})}},
+                   box({-0.6, -0.9, -5.6}, {0.2, 0.5, -5.5})});
   for (bool facing : {true, false}) {
     PreparedFrame p;
     prepare(p, c, "hemisphere", true, facing);
@@ -400,12 +400,14 @@ TEST(Frame, LastThicknessIsMeasuredBesideTheForeground) {
         ++measured;
         const float chord = unhidden.layer[0][i] - unhidden.depth[i];
         exact += std::fabs(t - chord) <= 1e-3f ? 1 : 0;
-        EXPECT_LE(t, 0.1f + 1e-3f) << x << ", " << y << " chord " << chord;  // never more than the slab is deep
+        // Never more than the slab is deep.
+        EXPECT_LE(t, 0.1f + 1e-3f) << x << ", " << y << " chord " << chord;
       }
     }
-    std::printf("[ measure  ] facing %s: slab hidden behind the box at %d px, its thickness "
-                "measured at %d, equal to its own chord at %d\n",
-                facing ? "given" : "alternating", slab, measured, exact);
+    std::printf(
+        "[ measure  ] facing %s: slab hidden behind the box at %d px, its thickness "
+        "measured at %d, equal to its own chord at %d\n",
+        facing ? "given" : "alternating", slab, measured, exact);
     EXPECT_GT(measured, slab / 2);
     EXPECT_GE(exact, measured * 9 / 10);
   }

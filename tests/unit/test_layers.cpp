@@ -395,7 +395,6 @@ TEST(Layers, LayersOfBackgroundPixelsAreNotRead) {
   for (int x = 0; x < SmallFrame::kSize; ++x) EXPECT_EQ(f.ao[size_t(x)], 1.0f);
 }
 
-
 TEST(Layers, ColumnBehindAPostKeepsItsMeasuredThickness) {
   // A 6 cm column 44 cm in front of a wall, and a 10 cm post 2 m in front of it: where the post
   // hides the column the hits are the post's front and back and the column's front, and the

@@ -31,9 +31,9 @@ constexpr int kMaxLanes = 16;
 constexpr int kLaneTable = kMaxLanes + 3;
 
 struct HemisphereRowArgs {
-  const float* depth;       // the frame's depth plane
-  const uint32_t* normals;  // the frame's packed normals
-  const float* layers;      // the frame's extra depth layers (Frame::layer_planes)
+  const float* depth;           // the frame's depth plane
+  const uint32_t* normals;      // the frame's packed normals
+  const float* layers;          // the frame's extra depth layers (Frame::layer_planes)
   const float* last_thickness;  // Frame::last_thickness_plane
   int extra_layers;
   int width, height;
@@ -473,11 +473,10 @@ class Hemisphere final : public Variant {
 
   void estimate(const Frame& f, const Tile& t, float* visibility) const override {
     const HemisphereRowArgs args{
-        f.depth_plane(), f.normal_plane(), f.layer_planes(), f.last_thickness_plane(),
-        f.extra_layers(),
-        f.width(),       f.height(),       f.camera().intrinsics(), radius_,
-        bias_ * radius_, thickness_,       crossing_tolerance_,     f.pixel_count(),
-        directions_,     steps_,           lane_offsets_.data()};
+        f.depth_plane(),  f.normal_plane(), f.layer_planes(), f.last_thickness_plane(),
+        f.extra_layers(), f.width(),        f.height(),       f.camera().intrinsics(),
+        radius_,          bias_ * radius_,  thickness_,       crossing_tolerance_,
+        f.pixel_count(),  directions_,      steps_,           lane_offsets_.data()};
     for (int y = t.y0; y < t.y1; ++y) {
       best_hemisphere_row()(args, y, t.x0, t.x1, visibility + f.index(t.x0, y));
     }
