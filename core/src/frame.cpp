@@ -127,8 +127,11 @@ SSAO_VECTORIZE bool Frame::search_step(const float* __restrict last,
     const bool on_third = std::fabs(std::fabs(third[i]) - last[i]) <= reach;
     const bool near = on_visible | on_second | on_third;
     const bool walking = (stopped[i] == 0.0f) & (last[i] > 0.0f) & near;
-    const bool match = walking & on_visible & (visible[i] != kBackground) & (second[i] < 0.0f);
     const float thickness = -second[i] - visible[i];
+    // A stretch too short to take the reciprocal of (hostile, subnormal depths) says nothing.
+    const bool measurable = thickness > 1e-30f;
+    const bool match =
+        walking & on_visible & (visible[i] != kBackground) & (second[i] < 0.0f) & measurable;
     best[i] = match ? std::max(best[i], thickness) : best[i];
     stopped[i] = (walking & !match) ? stopped[i] : 1.0f;
     walking_on |= int(walking & !match);
