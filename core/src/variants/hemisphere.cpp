@@ -167,15 +167,14 @@ HWY_NOINLINE void hemisphere_row_of(const HemisphereRowArgs& a, int y, int x0, i
   const VF inf = hn::Set(df, std::numeric_limits<float>::infinity());
   const VF zero = hn::Zero(df), one = hn::Set(df, 1.0f), half = hn::Set(df, 0.5f);
   const VF two = hn::Set(df, 2.0f);
-  const VF scale_u = hn::Set(df, cam.scale_u), scale_v = hn::Set(df, cam.scale_v);
-  const VF center_u = hn::Set(df, cam.center_u), center_v = hn::Set(df, cam.center_v);
   const VF inv_thickness = hn::Set(df, 1.0f / a.thickness);
   const VF radius = hn::Set(df, a.radius);
   const LaneProjection<VF> project(cam, a.width, a.height);
+  const VF scale_u = project.scale_u, scale_v = project.scale_v;
   // Vectors start at x0 + a multiple of `lanes` (itself a multiple of 4): one phase.
   const float* row_offsets =
       a.lane_offsets + size_t(y & 3) * a.directions * a.steps * 3 * kLaneTable + (x0 & 3);
-  const VF view_y_of_row = center_v - hn::Set(df, float(y) + 0.5f);
+  const VF view_y_of_row = project.center_v - hn::Set(df, float(y) + 0.5f);
 
   alignas(64) float depth_in[kMaxLanes];
   alignas(64) int32_t normal_in[kMaxLanes];
@@ -204,7 +203,7 @@ HWY_NOINLINE void hemisphere_row_of(const HemisphereRowArgs& a, int y, int x0, i
     // Position of the receivers.
     const VF u = hn::Iota(df, float(x) + 0.5f);
     const VF depth_scale = cam.orthographic ? one : safe_depth;
-    const VF px = (u - center_u) * scale_u * depth_scale;
+    const VF px = (u - project.center_u) * scale_u * depth_scale;
     const VF py = view_y_of_row * scale_v * depth_scale;
     const VF pz = hn::Neg(safe_depth);
 
