@@ -880,6 +880,27 @@ constexpr double kBandFine = 1.0, kBandCoarse = 6.0;
 constexpr int kBandErosion = 3;          // the band's pixels: geometry within 3 px (7x7 square)
 constexpr double kEdgeDepthJump = 0.05;  // an edge: |d - d_n| > 5 % of the nearer depth
 
+// One pass of a separable filter over `image` (w x h): each pixel folds the pixels up to
+// `radius` away along its row (along_rows) or column, i = -radius .. radius in order, clamped to
+// the edge: fold(accumulated, i, value), starting from `start`.
+template <class T, class Fold>
+std::vector<T> separable_pass(const std::vector<T>& image, int w, int h, int radius,
+                              bool along_rows, T start, Fold fold) {
+  std::vector<T> out(image.size());
+  for (int y = 0; y < h; ++y) {
+    for (int x = 0; x < w; ++x) {
+      T accumulated = start;
+      for (int i = -radius; i <= radius; ++i) {
+        const int nx = along_rows ? std::clamp(x + i, 0, w - 1) : x;
+        const int ny = along_rows ? y : std::clamp(y + i, 0, h - 1);
+        accumulated = fold(accumulated, i, image[size_t(ny) * size_t(w) + size_t(nx)]);
+      }
+      out[size_t(y) * size_t(w) + size_t(x)] = accumulated;
+    }
+  }
+  return out;
+}
+
 // `image` (w x h) blurred by a Gaussian of `sigma` pixels (see kBandFine).
 std::vector<double> gaussian_blur(const std::vector<double>& image, int w, int h, double sigma) {
   const int radius = static_cast<int>(std::ceil(3.0 * sigma));
@@ -889,53 +910,22 @@ std::vector<double> gaussian_blur(const std::vector<double>& image, int w, int h
     total += kernel[size_t(i + radius)] = std::exp(-0.5 * double(i * i) / (sigma * sigma));
   }
   for (double& k : kernel) k /= total;
-  std::vector<double> rows(image.size()), out(image.size());
-  for (int y = 0; y < h; ++y) {
-    const double* line = image.data() + size_t(y) * size_t(w);
-    for (int x = 0; x < w; ++x) {
-      double sum = 0.0;
-      for (int i = -radius; i <= radius; ++i) {
-        sum += kernel[size_t(i + radius)] * line[std::clamp(x + i, 0, w - 1)];
-      }
-      rows[size_t(y) * size_t(w) + size_t(x)] = sum;
-    }
-  }
-  for (int y = 0; y < h; ++y) {
-    for (int x = 0; x < w; ++x) {
-      double sum = 0.0;
-      for (int i = -radius; i <= radius; ++i) {
-        sum += kernel[size_t(i + radius)] *
-               rows[size_t(std::clamp(y + i, 0, h - 1)) * size_t(w) + size_t(x)];
-      }
-      out[size_t(y) * size_t(w) + size_t(x)] = sum;
-    }
-  }
-  return out;
+  const auto weigh = [&](double sum, int i, double value) {
+    return sum + kernel[size_t(i + radius)] * value;
+  };
+  return separable_pass(separable_pass(image, w, h, radius, true, 0.0, weigh), w, h, radius, false,
+                        0.0, weigh);
 }
 
 // `set` (w x h, 0 or 1) eroded by the (2 r + 1)^2 square: 1 where every pixel of the square that
-// lies inside the frame is 1 (separable: the minimum along rows, then along columns).
+// lies inside the frame is 1 (the minimum along rows, then along columns; clamping to the edge
+// repeats pixels of the frame, which leaves a minimum as it is).
 std::vector<unsigned char> erode(const std::vector<unsigned char>& set, int w, int h, int r) {
-  std::vector<unsigned char> rows(set.size()), out(set.size());
-  for (int y = 0; y < h; ++y) {
-    for (int x = 0; x < w; ++x) {
-      unsigned char all = 1;
-      for (int nx = std::max(x - r, 0); nx <= std::min(x + r, w - 1) && all; ++nx) {
-        all = set[size_t(y) * size_t(w) + size_t(nx)];
-      }
-      rows[size_t(y) * size_t(w) + size_t(x)] = all;
-    }
-  }
-  for (int y = 0; y < h; ++y) {
-    for (int x = 0; x < w; ++x) {
-      unsigned char all = 1;
-      for (int ny = std::max(y - r, 0); ny <= std::min(y + r, h - 1) && all; ++ny) {
-        all = rows[size_t(ny) * size_t(w) + size_t(x)];
-      }
-      out[size_t(y) * size_t(w) + size_t(x)] = all;
-    }
-  }
-  return out;
+  const auto minimum = [](unsigned char all, int, unsigned char value) {
+    return std::min(all, value);
+  };
+  return separable_pass(separable_pass(set, w, h, r, true, (unsigned char)1, minimum), w, h, r,
+                        false, (unsigned char)1, minimum);
 }
 
 // Whether the scored pixel p = (x, y) has a depth jump of more than kEdgeDepthJump to a
