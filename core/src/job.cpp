@@ -12,6 +12,7 @@
 #include "denoise.h"
 #include "error.h"
 #include "frame.h"
+#include "pixel_filter.h"
 #include "scratch.h"
 #include "simd.h"
 #include "variants/variant.h"
@@ -516,6 +517,7 @@ void Job::run() {
 
   const float radius = static_cast<float>(v.get_float("radius"));
   const Denoiser denoiser(seen, denoise_mode(v.get_string("denoise")), radius);
+  const float filter_weight = pixel_filter_weight(v.get_float("pixel_filter"));
   progress.set_stage(0.95, 1.0);
   denoiser.horizontal_pass(visibility.data(), tiles, progress);
 
@@ -542,12 +544,24 @@ void Job::run() {
     ScratchVector<float> denoised(size_t(t.x1 - t.x0) * size_t(t.y1 - t.y0));
     ScratchVector<float> coverage(composite_out_.attached() ? size_t(t.x1 - t.x0) : 0);
     const bool sky = !frame.has_geometry(t.x0, t.y0, t.x1, t.y1);
+    // The visibility resolved at full resolution over `resolved` (the tile, or with the pixel
+    // filter the tile and the pixels around it that the filter reads).
+    const auto resolve = [&](const Tile& resolved, float* into) {
+      if (half_resolution) {
+        upsample(frame, half_frame_, visibility.data(), denoiser, radius, resolved, into);
+      } else {
+        denoiser.vertical_pass(visibility.data(), resolved, into);
+      }
+    };
     if (sky) {
       std::fill(denoised.begin(), denoised.end(), 1.0f);
-    } else if (half_resolution) {
-      upsample(frame, half_frame_, visibility.data(), denoiser, radius, t, denoised.data());
+    } else if (filter_weight > 0.0f) {
+      const Tile around = pixel_filter_source(frame, t);
+      ScratchVector<float> resolved(size_t(around.x1 - around.x0) * size_t(around.y1 - around.y0));
+      resolve(around, resolved.data());
+      pixel_filter(frame, around, resolved.data(), t, filter_weight, denoised.data());
     } else {
-      denoiser.vertical_pass(visibility.data(), t, denoised.data());
+      resolve(t, denoised.data());
     }
     const int count = t.x1 - t.x0;
     GeometryCounter geometry;  // on the stack: its lanes are one aligned vector register

@@ -111,6 +111,12 @@ const std::vector<Param>& params() {
       string_param(kQuality, "denoise", "bilateral", "bilateral|box4|none",
                    "bilateral: depth- and normal-aware blur; box4: the seed code's 4x4 box blur; "
                    "none: raw estimate"),
+      float_param(kAo, "pixel_filter", 0.5, 0.0, 1.0, "pixels",
+                  "standard deviation of the Gaussian pixel filter the AO is seen through, as a "
+                  "renderer anti-aliases its passes: on a silhouette the AO mixes both surfaces' "
+                  "by their share of the pixel (Cycles' AO pass does; the Depth pass holds one "
+                  "surface); 0: one surface per pixel, a staircase along edges; 0.5: fitted to "
+                  "Cycles' default 1.5 px Blackman-Harris filter (measured)"),
       // --- output shaping: ao = remap_min + (remap_max - remap_min) * mix(1, raw^power, strength)
       float_param(kShaping, "strength", 1.0, 0.0, 1.0, "",
                   "0 leaves the image unchanged, 1 applies the full AO"),

@@ -315,9 +315,13 @@ TEST_P(Stress, DeepBackgroundBehindANearObject) {
   };
   Scene alone = ray_cast(cam, near), at_50 = backed_at(50), at_1e4 = backed_at(1e4);
   const double radius = 0.5;
-  const auto a = compute_ao(alone, cam, radius, variant().c_str());
-  const auto b50 = compute_ao(at_50, cam, radius, variant().c_str());
-  const auto b = compute_ao(at_1e4, cam, radius, variant().c_str());
+  // The estimate alone: the pixel filter mixes a silhouette's pixels with the surface behind
+  // them by design (as the renderer's anti-aliasing does), whatever its depth.
+  const auto estimate = [&](Scene& s) {
+    return compute_ao(s, cam, radius, variant().c_str(), true,
+                      [](Job& j) { j.set("pixel_filter", 0.0); });
+  };
+  const auto a = estimate(alone), b50 = estimate(at_50), b = estimate(at_1e4);
   EXPECT_TRUE(in_unit_range(b));
   auto on_near = [&](size_t i) { return alone.depth[i] < 40.0f; };
   double darkest = 1.0;
@@ -527,6 +531,9 @@ TEST_P(Stress, LowestAndHighestSampleCounts) {
     }
     c.extra = [values](Job& j) {
       for (const auto& [name, value] : values) j.set(name.c_str(), value);
+      // The estimates themselves: on a 16 x 12 frame the pixel filter's mixing of the crease
+      // with the walls beside it is as wide as the crease.
+      j.set("pixel_filter", 0.0);
     };
     if (counts.empty()) c.label += " (none read: the default)";
     // Measured plane mean >= 0.9352, min >= 0.9265 (volumetric: one mirror pair of rays does

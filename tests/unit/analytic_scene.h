@@ -47,9 +47,13 @@ struct Camera {
   // Ray through the centre of pixel (x, y), y = 0 on top, in view space (-Z forward). The
   // sensor (or ortho_scale) spans the larger image side, as the library's sensor_fit AUTO.
   void ray(int x, int y, V3& origin, V3& direction) const {
-    const double fit = width >= height ? 1.0 : double(width) / height;    // portrait: fit height
-    const double nx = ((x + 0.5) / width - 0.5) * fit;                    // -0.5 .. 0.5 on the fit
-    const double ny = (0.5 - (y + 0.5) / height) * height / width * fit;  // same units as nx
+    ray_at(x + 0.5, y + 0.5, origin, direction);
+  }
+  // Ray through image point (u, v): pixel (x, y) spans [x, x + 1) x [y, y + 1).
+  void ray_at(double u, double v, V3& origin, V3& direction) const {
+    const double fit = width >= height ? 1.0 : double(width) / height;  // portrait: fit height
+    const double nx = (u / width - 0.5) * fit;                          // -0.5 .. 0.5 on the fit
+    const double ny = (0.5 - v / height) * height / width * fit;        // same units as nx
     if (ortho) {
       origin = {nx * ortho_scale, ny * ortho_scale, 0.0};
       direction = {0.0, 0.0, -1.0};
@@ -105,6 +109,18 @@ inline double exit_solid(const Solid& solid, V3 o, V3 d) {
   return t_exit;
 }
 
+// The nearest solid a ray enters: its distance along the ray (+inf: none) and the entered face's
+// normal.
+inline double first_hit(const std::vector<Solid>& solids, V3 o, V3 d, V3& normal) {
+  double best = std::numeric_limits<double>::infinity();
+  for (const Solid& solid : solids) {
+    double t = 0;
+    V3 n{0, 0, 0};
+    if (enter_solid(solid, o, d, t, n) && t < best) best = t, normal = n;
+  }
+  return best;
+}
+
 inline Scene ray_cast(const Camera& cam, const std::vector<Solid>& solids) {
   Scene s;
   s.width = cam.width;
@@ -121,13 +137,8 @@ inline Scene ray_cast(const Camera& cam, const std::vector<Solid>& solids) {
     for (int x = 0; x < cam.width; ++x) {
       V3 o, d;
       cam.ray(x, y, o, d);
-      double best_t = std::numeric_limits<double>::infinity();
       V3 best_normal{0, 0, 0};
-      for (const Solid& solid : solids) {
-        double t = 0;
-        V3 normal{0, 0, 0};
-        if (enter_solid(solid, o, d, t, normal) && t < best_t) best_t = t, best_normal = normal;
-      }
+      const double best_t = first_hit(solids, o, d, best_normal);
       if (!std::isfinite(best_t)) continue;
       const V3 p = o + d * best_t;
       const size_t i = size_t(y) * cam.width + x;
