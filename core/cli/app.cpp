@@ -3,11 +3,13 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <future>
+#include <set>
 #include <string>
 
 #include "ssao/ssao.hpp"
@@ -367,6 +369,55 @@ void run_sequence(const Options& options) {
   };
   size_t next_index = prefetch(0);
 
+  // The temporal filter (temporal_frames) averages each frame with the frames just before it
+  // that the job computed; in increasing order (the library's rule) the frames of the list
+  // within its reach come before it. A frame whose predecessors this run did not compute (the
+  // first of a chunk, one after a skipped frame) gets them computed first, not written, so that
+  // every frame is what a serial run writes.
+  const bool increasing =
+      std::adjacent_find(options.sequence.begin(), options.sequence.end(),
+                         [](int a, int b) { return a >= b; }) == options.sequence.end();
+  std::set<int> estimated;  // the frames this job holds an estimate of
+  auto run_frame = [&](int frame, FrameInputs& f, const Options& o) {
+    ssao_tools::apply_camera(job.get(), f.camera, o.camera);
+    ssao_tools::apply_params(job, o.params);
+    // Counted from the list's first frame: the library's frame numbers start at 0.
+    job.set("frame", increasing ? frame - options.sequence.front() : -1);
+    attach_images(job, f.in, out);
+    require_camera_for_normals(job, f.in, f.camera, o.camera);
+    choose_radius(o, f.camera, job);
+    job.set_progress(&ProgressReporter::callback, &interrupt);
+    const ssao_status result = ssao_job_run(job.get());
+    job.set_progress(nullptr, nullptr);
+    if (result == SSAO_ERROR_CANCELLED || ProgressReporter::interrupted()) {
+      throw ssao_tools::Error("interrupted");
+    }
+    ssao::api::check_status(result, "SSAO failed");
+    estimated.insert(frame);
+  };
+  auto warm_up = [&](int frame, const Options& o) {
+    if (!increasing) return;
+    ssao_tools::apply_params(job, o.params);
+    const int reach = job.get_int("temporal_frames");
+    for (const int earlier : options.sequence) {
+      if (earlier <= frame - reach || earlier >= frame || estimated.count(earlier)) continue;
+      const Options w = frame_options(options, input, output, camera, earlier);
+      try {
+        FrameInputs inputs = load(w, Inputs());
+        run_frame(earlier, inputs, w);
+        if (!options.quiet && !options.json_progress) {
+          std::fprintf(stderr,
+                       "ssao: frame %d computed first (not written): frame %d averages "
+                       "it in (temporal_frames %d)\n",
+                       earlier, frame, reach);
+        }
+      } catch (const std::exception&) {
+        if (ProgressReporter::interrupted()) throw;
+        // A serial run failed on it too (and said so); this frame goes without it, as there.
+      }
+    }
+  };
+
   for (size_t i = 0; i < total; ++i) {
     const int frame = options.frames[i];
     const Options o = frame_options(options, input, output, camera, frame);
@@ -382,18 +433,8 @@ void run_sequence(const Options& options) {
         next_index = prefetch(i + 1);  // read the next frame while this one computes
         refuse_overwriting_inputs(o);
         check_output_folder(o);
-        ssao_tools::apply_camera(job.get(), f.camera, o.camera);
-        ssao_tools::apply_params(job, o.params);
-        attach_images(job, f.in, out);
-        require_camera_for_normals(job, f.in, f.camera, o.camera);
-        choose_radius(o, f.camera, job);
-        job.set_progress(&ProgressReporter::callback, &interrupt);
-        const ssao_status result = ssao_job_run(job.get());
-        job.set_progress(nullptr, nullptr);
-        if (result == SSAO_ERROR_CANCELLED || ProgressReporter::interrupted()) {
-          throw ssao_tools::Error("interrupted");
-        }
-        ssao::api::check_status(result, "SSAO failed");
+        warm_up(frame, o);
+        run_frame(frame, f, o);
         write_output(o, f.in, out);
         size_t count = 0;
         mean = mean_ao(job, count);

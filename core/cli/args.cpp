@@ -147,6 +147,7 @@ const std::vector<FrontOption>& front_options() {
 
 // --chunk-size / --chunk-index / --list-chunks: checked, and --frames narrowed to the chunk.
 void apply_chunking(Options& options) {
+  options.sequence = options.frames;
   if (options.chunk_size == 0) {
     if (options.chunk_index >= 0 || options.list_chunks) {
       throw UsageError("--chunk-index and --list-chunks need --chunk-size N");
@@ -260,7 +261,9 @@ std::string usage_text(const std::vector<ssao_param_desc>& table) {
   param_section("camera",
                 "Camera parameters (set from --camera CAM.json, matrix_world giving\n"
                 "camera_to_world; a flag given here overrides the file):");
-  param_section("execution", "Execution (results do not depend on it):");
+  param_section("execution",
+                "Execution and sequences (threads: results do not depend on it; frame and\n"
+                "temporal_frames: the temporal filter of --frames sequences):");
 
   text +=
       "\n"

@@ -41,6 +41,9 @@ struct Options {
   std::string frames_text;
   bool skip_existing = false;
   bool json_progress = false;
+  // The whole --frames list, also when `frames` holds one chunk of it: the frames before a
+  // chunk that the temporal filter reads.
+  std::vector<int> sequence;
   // Farm chunks: with chunk_index >= 0, `frames` holds only that chunk once parsed.
   size_t chunk_size = 0;  // 0: no chunking
   int chunk_index = -1;

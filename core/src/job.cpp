@@ -15,6 +15,7 @@
 #include "pixel_filter.h"
 #include "scratch.h"
 #include "simd.h"
+#include "temporal.h"
 #include "variants/variant.h"
 
 namespace ssao {
@@ -518,6 +519,10 @@ void Job::run() {
   const float radius = static_cast<float>(v.get_float("radius"));
   const Denoiser denoiser(seen, denoise_mode(v.get_string("denoise")), radius);
   const float filter_weight = pixel_filter_weight(v.get_float("pixel_filter"));
+  // A frame of a sequence (frame >= 0) averages the frames before it that this job computed.
+  const int frame_number = v.get_int("frame");
+  temporal_.begin(frame_number, frame_number >= 0 ? v.get_int("temporal_frames") : 1, camera,
+                  in.camera_to_world, window);
   progress.set_stage(0.95, 1.0);
   denoiser.horizontal_pass(visibility.data(), tiles, progress);
 
@@ -563,6 +568,7 @@ void Job::run() {
     } else {
       resolve(t, denoised.data());
     }
+    temporal_.blend(frame, t, denoised.data());
     const int count = t.x1 - t.x0;
     GeometryCounter geometry;  // on the stack: its lanes are one aligned vector register
     for (int y = t.y0; y < t.y1; ++y) {
@@ -586,6 +592,7 @@ void Job::run() {
   }
   last_run_ = {run.geometry_pixels,
                run.geometry_pixels > 0 ? run.ao_sum / double(run.geometry_pixels) : 1.0};
+  temporal_.commit();
   has_run_ = true;
   progress.report(1.0);
 }

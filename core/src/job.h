@@ -10,6 +10,7 @@
 #include "frame.h"
 #include "image_view.h"
 #include "params.h"
+#include "temporal.h"
 #include "tiles.h"
 
 namespace ssao {
@@ -59,6 +60,8 @@ class Job {
   std::unique_ptr<TilePool> pool_;
   Frame frame_, half_frame_;
   std::vector<float> visibility_;
+  // The frames before this one, for the temporal filter (temporal.h).
+  TemporalHistory temporal_;
   // The slot an image name attaches to, nullptr for an unknown name.
   ImageView* image_slot(const char* name);
   // How many extra depth layers are attached (depth2, depth3, ... without a gap).

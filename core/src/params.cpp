@@ -117,6 +117,17 @@ const std::vector<Param>& params() {
                   "by their share of the pixel (Cycles' AO pass does; the Depth pass holds one "
                   "surface); 0: one surface per pixel, a staircase along edges; 0.5: fitted to "
                   "Cycles' default 1.5 px Blackman-Harris filter (measured)"),
+      int_param(kExecution, "temporal_frames", 3, 1, 8, "frames",
+                "in a sequence (frame >= 0), the AO averages this many frames: this one and the "
+                "frames numbered just before it that the same job computed, each carried to "
+                "this frame's pixels through its depth and camera_to_world; a pixel the earlier "
+                "frame did not see, or whose AO changed by more than 0.1 (something moved), "
+                "takes no part. Steadies the sampling pattern's crawl on camera moves (measured: "
+                "docs/performance.md); 1: each frame alone"),
+      int_param(kExecution, "frame", -1, -1, 2147483647, "",
+                "this frame's number in its sequence, for temporal_frames; a job's frames must "
+                "come in increasing order (the command line's --frames sets it); -1: a frame on "
+                "its own"),
       // --- output shaping: ao = remap_min + (remap_max - remap_min) * mix(1, raw^power, strength)
       float_param(kShaping, "strength", 1.0, 0.0, 1.0, "",
                   "0 leaves the image unchanged, 1 applies the full AO"),

@@ -443,12 +443,13 @@ class SequenceTest(CliTestCase):
 
     LAYER_CHANNELS = property(lambda self: DepthLayersTest.LAYER_CHANNELS)  # for layer_planes
 
-    def write_frames(self, frames, pattern="in.{:04d}.exr"):
-        """Frames whose box sits at a different depth each (so that they differ)."""
+    def write_frames(self, frames, pattern="in.{:04d}.exr", step=0.3):
+        """Frames whose box sits at a different depth each (so that they differ), `step`
+        farther each frame."""
         for frame in frames:
             planes = {k: v.copy() for k, v in self.planes.items()}
             box = planes["ViewLayer.Depth.Z"] == BOX_DEPTH
-            planes["ViewLayer.Depth.Z"][box] = BOX_DEPTH + 0.3 * frame
+            planes["ViewLayer.Depth.Z"][box] = BOX_DEPTH + step * frame
             write_exr(self.path(pattern.format(frame)), planes, BLENDER_CHANNELS)
 
     def run_sequence(self, *args, inp="in.####.exr", out="out.####.exr"):
@@ -460,7 +461,8 @@ class SequenceTest(CliTestCase):
         whole = open(self.path("in.0001.exr"), "rb").read()
         with open(self.path("in.0005.exr"), "wb") as f:  # a truncated frame
             f.write(whole[:len(whole) // 2])
-        proc = self.run_sequence("--frames", "1-5")
+        # Each frame alone (the temporal filter averages earlier frames in: test below).
+        proc = self.run_sequence("--frames", "1-5", "--temporal-frames", "1")
         self.assertEqual(proc.returncode, 1, proc.stderr)
         self.assertIn("frame 3 (3/5): error: cannot read", proc.stderr)
         self.assertIn("frame 5 (5/5): error: cannot read", proc.stderr)
@@ -486,6 +488,40 @@ class SequenceTest(CliTestCase):
                 self.assertFalse(np.array_equal(ao, previous), "frames should differ")
             previous = ao
 
+    def test_temporal_filter_chunks_equal_a_serial_run(self):
+        # The default averages each frame with the two before it (temporal_frames 3); a chunk
+        # computes the frames before its first one without writing them, so every chunk size
+        # writes what the serial run writes, bit for bit. The box moves by 0.2 % of its depth
+        # a frame: its AO changes by less than noise does, so the frames average.
+        self.write_frames([1, 2, 3, 4, 5, 6, 7], step=0.01)
+        self.assertEqual(self.run_sequence("--frames", "1-7").returncode, 0)
+        for size in (1, 3):
+            for index in range((7 + size - 1) // size):
+                proc = self.run_sequence("--frames", "1-7", "--chunk-size", str(size),
+                                         "--chunk-index", str(index),
+                                         out=f"chunk{size}_{index}.####.exr")
+                self.assertEqual(proc.returncode, 0, proc.stderr)
+                first = 1 + index * size
+                if first > 1:
+                    self.assertIn(f"frame {first - 1} computed first (not written)", proc.stderr)
+                    self.assertFalse(os.path.exists(
+                        self.path(f"chunk{size}_{index}.{first - 1:04d}.exr")))
+            for frame in range(1, 8):
+                _, serial = read_image(self.path(f"out.{frame:04d}.exr"))
+                _, chunked = read_image(self.path(f"chunk{size}_{(frame - 1) // size}."
+                                                  f"{frame:04d}.exr"))
+                np.testing.assert_array_equal(chunked, serial, f"frame {frame}, chunks of {size}")
+        # The first frame has nothing before it: the frame alone. Later ones average the box's
+        # AO over the frames.
+        for frame, same in ((1, True), (4, False)):
+            alone = self.path(f"alone.{frame}.exr")
+            proc = self.run_ssao(self.path(f"in.{frame:04d}.exr"), "-o", alone, "--camera",
+                                 self.camera, "--radius", str(RADIUS), default_paths=False)
+            self.assertEqual(proc.returncode, 0, proc.stderr)
+            _, serial = read_image(self.path(f"out.{frame:04d}.exr"))
+            _, single = read_image(alone)
+            self.assertEqual(np.array_equal(serial, single), same, f"frame {frame}")
+
     def test_sequence_frames_with_other_passes_and_sizes(self):
         # Buffers pass from frame to frame, and the job from run to run: a frame without
         # normals, layers or alpha after one with them, and a smaller frame between larger
@@ -501,7 +537,7 @@ class SequenceTest(CliTestCase):
         for args in ((), ("--ao-only",)):
             proc = self.run_ssao(self.path("in.####.exr"), "-o", self.path("out.####.exr"),
                                  "--camera", self.camera, "--radius", RADIUS, "--frames", "1-5",
-                                 *args, default_paths=False)
+                                 "--temporal-frames", "1", *args, default_paths=False)
             self.assertEqual(proc.returncode, 0, proc.stderr)
             for frame in frames:
                 alone = self.path(f"alone.{frame}.exr")
@@ -651,7 +687,7 @@ class OverscanTest(CliTestCase):
         proc = self.run_ssao(self.path("shot.####.exr"), "-o", self.path("ao.####.exr"),
                              "--camera", camera, "--radius", RADIUS, "--ao-only", "--frames",
                              "1-2", "--chunk-size", "1", "--chunk-index", "1",
-                             default_paths=False)
+                             "--temporal-frames", "1", default_paths=False)
         self.assertEqual(proc.returncode, 0, proc.stderr)
         self.assertFalse(os.path.exists(self.path("ao.0001.exr")), "chunk 1 is frame 2 alone")
         _, sequence_frame = read_image(self.path("ao.0002.exr"))
