@@ -74,11 +74,14 @@ def parse_sets(items):
 
 
 class Runner:
-    def __init__(self, path, params, depth, normal, layers):
+    def __init__(self, path, params, depth, normal, layers, sequence=False):
         self.lib = ssao.load_library(path)
         self.ao = np.zeros(depth.shape, np.float32)
         self.job = ssao.Job(self.lib)
         types = {p["name"]: p["type"] for p in ssao.parameters(self.lib)}
+        # --sequence: every run is the next frame of a sequence (a library without the frame
+        # parameter runs them as it always did).
+        self.next_frame = 0 if sequence and "frame" in types else None
         for name, value in params.items():
             if types.get(name) == ssao.PARAM_INT:
                 value = int(value)
@@ -95,6 +98,9 @@ class Runner:
         self.times = []
 
     def run(self, timed=True):
+        if self.next_frame is not None:
+            self.job.set("frame", self.next_frame)
+            self.next_frame += 1
         start = time.perf_counter()
         self.job.run()
         if timed:
@@ -115,6 +121,10 @@ def main():
     parser.add_argument("--candidate-set", action="append", default=[])
     parser.add_argument("--baseline-layers", type=int, default=0, metavar="N")
     parser.add_argument("--candidate-layers", type=int, default=0, metavar="N")
+    parser.add_argument("--sequence", action="store_true",
+                        help="run each library's job as consecutive frames of a sequence "
+                             "(parameter frame 0, 1, 2, ...): the cost of a frame whose "
+                             "temporal filter has its earlier frames")
     args = parser.parse_args()
     if args.repeat < 1:
         parser.error("--repeat must be at least 1")
@@ -130,9 +140,9 @@ def main():
     candidate = args.candidate or os.path.join(os.path.dirname(os.path.abspath(__file__)), "..",
                                                "build", "lib", "libssao.so")
     runners = {"baseline": Runner(args.baseline, {**common, **parse_sets(args.baseline_set)},
-                                  depth, normal, layers[:args.baseline_layers]),
+                                  depth, normal, layers[:args.baseline_layers], args.sequence),
                "candidate": Runner(candidate, {**common, **parse_sets(args.candidate_set)},
-                                   depth, normal, layers[:args.candidate_layers])}
+                                   depth, normal, layers[:args.candidate_layers], args.sequence)}
     for r in runners.values():
         r.run(timed=False)
     for _ in range(args.repeat):
