@@ -2,7 +2,8 @@
 // A Flamenco 3 job type: build/bin/ssao over a shot, one task per chunk of frames. Copy this file
 // into the Manager's scripts/ folder (the file name is the job type's name). docs/farm.md.
 //
-// Every task runs `ssao INPUT --camera CAMERA -o OUTPUT --frames CHUNK [--radius R] [EXTRA]`;
+// Every task runs `ssao INPUT --camera CAMERA -o OUTPUT --frames FRAMES --chunk-size N
+// --chunk-index I [--radius R] [EXTRA]` (the whole list, its chunk by index);
 // each frame is bit for bit what a serial run writes, whatever the chunks.
 
 const JOB_TYPE = {
@@ -72,15 +73,21 @@ function compileJob(job) {
     }
   }
   const radius = settings.radius > 0 ? ["--radius", String(settings.radius)] : [];
+  // Each task gets the whole frame list and its chunk's index (ssao cuts the list as
+  // frameChunker does: in order, chunk_size frames each), so that it can compute the frames
+  // before its chunk that the temporal filter averages in, without writing them.
+  let index = 0;
   for (const chunk of frameChunker(settings.frames, settings.chunk_size)) {
     const task = author.Task(`ssao-${chunk}`, "misc");
     task.addCommand(
       author.Command("exec", {
         exe: settings.ssao,
         args: [settings.input, "--camera", settings.camera, "-o", settings.output, "--frames",
-               chunk].concat(radius, extra),
+               settings.frames, "--chunk-size", String(settings.chunk_size), "--chunk-index",
+               String(index)].concat(radius, extra),
       }),
     );
     job.addTask(task);
+    index += 1;
   }
 }
