@@ -202,3 +202,27 @@ TEST(Temporal, FramesOnTheirOwnOrNotFollowingAreUnchanged) {
     }
   }
 }
+
+// The filter's output does not depend on the thread count (each tile carries its own pixels).
+TEST(Temporal, SequencesAreTheSameForAnyThreadCount) {
+  Camera cam;
+  const double step = 0.05;
+  std::vector<std::vector<float>> runs[2];
+  for (int k = 0; k < 2; ++k) {
+    Job job;
+    configure(job, cam, 3);
+    job.set("threads", k == 0 ? 1 : 3);
+    for (int f = 0; f < 4; ++f) {
+      const V3 position{step * f, 0, 0};
+      Scene s = ray_cast(cam, seen_from(room(), position));
+      runs[k].push_back(run_frame(job, s, position, f));
+    }
+  }
+  for (int f = 0; f < 4; ++f) EXPECT_EQ(runs[0][f], runs[1][f]) << "frame " << f;
+  // And the filter did something: frame 3 is not what it is alone.
+  Job alone;
+  configure(alone, cam, 1);
+  const V3 last{step * 3, 0, 0};
+  Scene s = ray_cast(cam, seen_from(room(), last));
+  EXPECT_NE(run_frame(alone, s, last, 3), runs[0][3]);
+}
