@@ -41,6 +41,7 @@ KIT_SCRIPTS = [os.path.join(BLENDER_SCRIPTS, name)
 SWEEP_SCRIPT = os.path.join(BLENDER_SCRIPTS, "cycles_ao_sweep.py")
 # A frame of a camera move through a kit scene (benchmarks/flicker.py).
 SEQUENCE_SCRIPT = os.path.join(BLENDER_SCRIPTS, "benchmark_sequence.py")
+MOVING_SCRIPT = os.path.join(BLENDER_SCRIPTS, "benchmark_moving.py")
 # The extra depth layers and guard band of a scene (and what their render depends on).
 LAYERS_SCRIPT = os.path.join(BLENDER_SCRIPTS, "benchmark_layers.py")
 LAYERS_SOURCES = KIT_SCRIPTS + [LAYERS_SCRIPT, os.path.join(BLENDER_SCRIPTS, "render_layers.py")] + [
@@ -181,21 +182,27 @@ def kit_key(blender_version, arguments, sources=KIT_SCRIPTS):
     return digest.hexdigest()[:12]
 
 
-def kit_render(args, blender_version, scene, size, samples, seed=1, border=None, truck_px=None):
+def kit_render(args, blender_version, scene, size, samples, seed=1, border=None, truck_px=None,
+               move=None):
     """The prefix of a cached reference render, rendering it first if it is not there; with
-    truck_px, a frame of a camera move (scripts/blender/benchmark_sequence.py)."""
+    truck_px, a frame of a camera move (scripts/blender/benchmark_sequence.py); with move
+    ("NAME,DX,DY,DZ"), one of a moving object (scripts/blender/benchmark_moving.py)."""
     arguments = ["--scene", scene, "--width", str(size[0]), "--height", str(size[1]),
                  "--samples", str(samples), "--seed", str(seed)]
     if border:
         arguments += ["--border", ",".join(str(v) for v in border)]
-    script, sources, move = KIT_SCRIPTS[0], KIT_SCRIPTS, ""
+    script, sources, move_label = KIT_SCRIPTS[0], KIT_SCRIPTS, ""
     if truck_px is not None:
         arguments += ["--truck-px", repr(float(truck_px))]
         script, sources = SEQUENCE_SCRIPT, KIT_SCRIPTS + [SEQUENCE_SCRIPT]
-        move = "-truck%g" % truck_px
+        move_label = "-truck%g" % truck_px
+    elif move is not None:
+        arguments += ["--move", move]
+        script, sources = MOVING_SCRIPT, KIT_SCRIPTS + [SEQUENCE_SCRIPT, MOVING_SCRIPT]
+        move_label = "-move" + move.replace(",", "_")
     # The key leaves out the thread count: it changes the render's speed, not its pixels.
     name = "%s-%ds%d%s%s-%s" % (label(scene, size), samples, seed, "-part" if border else "",
-                                move, kit_key(blender_version, arguments, sources))
+                                move_label, kit_key(blender_version, arguments, sources))
     folder = os.path.join(args.kit, name)
     prefix = os.path.join(folder, "ref")
     if os.path.isfile(prefix + ".json"):
