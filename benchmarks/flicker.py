@@ -242,10 +242,12 @@ def moving_text(m):
             "reference. Over the %d pixels whose reference AO changed by more than %.2f from the "
             "frame before (the box and its contact shadow moved), the default's RMSE is %.4f, "
             "each frame alone %.4f: the difference is the trail the temporal filter leaves, "
-            "changes below its rejection threshold (0.1) carried from earlier frames; the "
-            "largest difference between the two anywhere is %.4f. (Measured once with a "
-            "threshold of 0.05: 0.0801 there, a quarter of the trail, but a quarter to a half of "
-            "the flicker's gain lost: contact 0.0083, cavity 0.0185 in occluded pixels.)"
+            "changes carried from earlier frames that its rejection threshold (0.1) and its "
+            "clamp to the range of the frame's own values around the pixel (+- 0.01) let "
+            "through; the largest difference between the two anywhere is %.4f. (Measured once: "
+            "without the clamp 0.0876; a rejection threshold of 0.05 instead, 0.0801, but a "
+            "quarter to a half of the flicker's gain lost: contact 0.0083, cavity 0.0185 in "
+            "occluded pixels.)"
             % (m["scene"], m["object"], m["step"], FRAMES, m["pixels"], CHANGED_BY,
                m["rmse_default"], m["rmse_alone"], m["largest"]))
 

@@ -27,6 +27,8 @@ struct CarryArgs {
 // A frame carries to another where its depth agrees within this fraction and its value
 // differs by at most this much (TemporalHistory's constants).
 constexpr float kCarryDepthAgreement = 0.005f, kCarryRejection = 0.1f;
+// How far a carried value may lie outside the range of the frame's own values around it.
+constexpr float kCarryMargin = 0.01f;
 }  // namespace ssao
 #endif
 
@@ -41,8 +43,8 @@ namespace hn = hwy::HWY_NAMESPACE;
 // and the value is within kCarryRejection of its own. The nearest pixel rather than a bilinear
 // mix of four: a quarter of the gathers, and on the kit's camera moves less flicker (contact,
 // occluded pixels: 0.0062 against 0.0074).
-HWY_NOINLINE void carry_row(const CarryArgs& a, const float* depth, const float* own, int count,
-                            float* sum, float* n) {
+HWY_NOINLINE void carry_row(const CarryArgs& a, const float* depth, const float* own,
+                            const float* low, const float* high, int count, float* sum, float* n) {
   const hn::ScalableTag<float> df;
   const hn::RebindToSigned<decltype(df)> di;
   using VF = hn::Vec<decltype(df)>;
@@ -56,18 +58,22 @@ HWY_NOINLINE void carry_row(const CarryArgs& a, const float* depth, const float*
   const VF y_unit = hn::Set(df, (a.here.center_v - a.v) * a.here.scale_v);
   const VF max_x = hn::Set(df, float(a.width)), max_y = hn::Set(df, float(a.height));
   const auto width = hn::Set(di, a.width);
-  alignas(64) float stage[4][16];
+  alignas(64) float stage[6][16];
   for (int i = 0; i < count; i += lanes) {
     const int here = std::min(lanes, count - i);
     const float *d_at = depth + i, *own_at = own + i, *sum_at = sum + i, *n_at = n + i;
+    const float *low_at = low + i, *high_at = high + i;
     if (here < lanes) {  // stage the last lanes, padded with background
       for (int k = 0; k < lanes; ++k) {
         stage[0][k] = k < here ? depth[i + k] : std::numeric_limits<float>::infinity();
         stage[1][k] = k < here ? own[i + k] : 0.0f;
         stage[2][k] = k < here ? sum[i + k] : 0.0f;
         stage[3][k] = k < here ? n[i + k] : 0.0f;
+        stage[4][k] = k < here ? low[i + k] : 0.0f;
+        stage[5][k] = k < here ? high[i + k] : 0.0f;
       }
       d_at = stage[0], own_at = stage[1], sum_at = stage[2], n_at = stage[3];
+      low_at = stage[4], high_at = stage[5];
     }
     const VF d = hn::LoadU(df, d_at);
     const auto geometry = hn::Lt(d, inf);
@@ -98,7 +104,11 @@ HWY_NOINLINE void carry_row(const CarryArgs& a, const float* depth, const float*
     const auto index = y * width + x;
     const VF tolerance = hn::Set(df, kCarryDepthAgreement) * z;
     const auto same_surface = hn::Le(hn::Abs(hn::GatherIndex(df, a.depth, index) - z), tolerance);
-    const VF carried = hn::GatherIndex(df, a.value, index);
+    // Clamped to the range of this frame's own values around the pixel (plus a margin): a
+    // value an earlier frame had where something has since moved does not trail.
+    const VF margin = hn::Set(df, kCarryMargin);
+    const VF carried = hn::Clamp(hn::GatherIndex(df, a.value, index),
+                                 hn::LoadU(df, low_at) - margin, hn::LoadU(df, high_at) + margin);
     const VF own_v = hn::LoadU(df, own_at);
     const auto close = hn::Le(hn::Abs(carried - own_v), hn::Set(df, kCarryRejection));
     const auto takes = hn::And(hn::And(inside, same_surface), close);
@@ -125,6 +135,7 @@ HWY_AFTER_NAMESPACE();
 #include <cmath>
 
 #include "scratch.h"
+#include "simd.h"
 #include "temporal.h"
 #include "variants/simd_dispatch.h"
 
@@ -164,6 +175,43 @@ void multiply_affine(const double* a, const double* b, double* out) {
       for (int k = 0; k < 3; ++k) sum += a[4 * row + k] * b[4 * k + col];
       out[4 * row + col] = sum;
     }
+  }
+}
+
+// The smallest and largest of each value and its two neighbours in a row (the row's ends
+// repeated). Selects only: the loops vectorise.
+SSAO_VECTORIZE void row_range(const float* __restrict values, int count, float* __restrict low,
+                              float* __restrict high) {
+  if (count == 1) {
+    low[0] = high[0] = values[0];
+    return;
+  }
+  low[0] = std::min(values[0], values[1]), high[0] = std::max(values[0], values[1]);
+  for (int i = 1; i + 1 < count; ++i) {
+    const float a = values[i - 1], b = values[i], c = values[i + 1];
+    const float ab_low = a < b ? a : b, ab_high = a < b ? b : a;
+    low[i] = ab_low < c ? ab_low : c;
+    high[i] = ab_high < c ? c : ab_high;
+  }
+  low[count - 1] = std::min(values[count - 2], values[count - 1]);
+  high[count - 1] = std::max(values[count - 2], values[count - 1]);
+}
+
+// Rows a, b and c (indices into planes of `stride` floats a row) of row_range's results
+// combined.
+SSAO_VECTORIZE void column_range(const float* row_low, const float* row_high, size_t stride, int a,
+                                 int b, int c, int count, float* __restrict low,
+                                 float* __restrict high) {
+  const float* __restrict la = row_low + size_t(a) * stride;
+  const float* __restrict lb = row_low + size_t(b) * stride;
+  const float* __restrict lc = row_low + size_t(c) * stride;
+  const float* __restrict ha = row_high + size_t(a) * stride;
+  const float* __restrict hb = row_high + size_t(b) * stride;
+  const float* __restrict hc = row_high + size_t(c) * stride;
+  for (int i = 0; i < count; ++i) {
+    const float l = la[i] < lb[i] ? la[i] : lb[i], h = ha[i] < hb[i] ? hb[i] : ha[i];
+    low[i] = l < lc[i] ? l : lc[i];
+    high[i] = h < hc[i] ? hc[i] : h;
   }
 }
 
@@ -207,16 +255,30 @@ void TemporalHistory::begin(int frame, int frames, const CameraModel& camera,
 
 void TemporalHistory::blend(const Frame& frame, const Tile& t, float* values) {
   if (frames_ <= 1) return;
-  const int width = t.x1 - t.x0;
-  ScratchVector<float> sum(earlier_.empty() ? 0 : width), count(earlier_.empty() ? 0 : width);
+  const int width = t.x1 - t.x0, height = t.y1 - t.y0;
+  const auto at = [&](int y) {  // row y's place in this frame's record
+    return size_t(y - window_.y0) * size_t(current_.width) + size_t(t.x0 - window_.x0);
+  };
+  // This frame's values before averaging, for the frames after it.
+  for (int y = t.y0; y < t.y1; ++y) {
+    std::copy_n(frame.depth_plane() + frame.index(t.x0, y), width, current_.depth.data() + at(y));
+    std::copy_n(values + size_t(y - t.y0) * width, width, current_.visibility.data() + at(y));
+  }
+  if (earlier_.empty()) return;
+  // The range of this frame's values around each pixel (3 x 3 within the tile): each row's
+  // 3-wide range first, then three rows of those.
+  ScratchVector<float> row_low(size_t(width) * height), row_high(size_t(width) * height);
+  for (int y = t.y0; y < t.y1; ++y) {
+    row_range(current_.visibility.data() + at(y), width, row_low.data() + size_t(y - t.y0) * width,
+              row_high.data() + size_t(y - t.y0) * width);
+  }
+  ScratchVector<float> sum(width), count(width), low(width), high(width);
   for (int y = t.y0; y < t.y1; ++y) {
     const float* depth = frame.depth_plane() + frame.index(t.x0, y);
     float* row = values + size_t(y - t.y0) * width;
-    const size_t at = size_t(y - window_.y0) * size_t(current_.width) + size_t(t.x0 - window_.x0);
-    // This frame's values before averaging, for the frames after it.
-    std::copy_n(depth, width, current_.depth.data() + at);
-    std::copy_n(row, width, current_.visibility.data() + at);
-    if (earlier_.empty()) continue;
+    const int above = std::max(y - 1, t.y0) - t.y0, below = std::min(y + 1, t.y1 - 1) - t.y0;
+    column_range(row_low.data(), row_high.data(), size_t(width), above, y - t.y0, below, width,
+                 low.data(), high.data());
     std::copy_n(row, width, sum.data());
     std::fill_n(count.data(), width, 1.0f);
     const float u0 = float(t.x0 - window_.x0) + 0.5f, v = float(y - window_.y0) + 0.5f;
@@ -231,7 +293,7 @@ void TemporalHistory::blend(const Frame& frame, const Tile& t, float* values) {
                      u0,
                      v};
       for (int k = 0; k < 12; ++k) args.to_entry[k] = float(e.to_entry[k]);
-      best_carry_row()(args, depth, row, width, sum.data(), count.data());
+      best_carry_row()(args, depth, row, low.data(), high.data(), width, sum.data(), count.data());
     }
     for (int i = 0; i < width; ++i) row[i] = sum[i] / count[i];
   }

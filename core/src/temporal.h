@@ -5,7 +5,9 @@
 // a pattern fixed to the screen, which crawls over the surfaces as the camera moves; averaged
 // over a few frames it no longer does. What cannot be carried takes no part: a pixel the
 // earlier frame did not see (its depth disagrees by more than 0.5 %), or whose AO changed by
-// more than noise does (0.1: an object that moved, a shadow that moved with it, a cut).
+// more than noise does (0.1: an object that moved, a shadow that moved with it, a cut); a
+// carried value is also clamped to the range of this frame's own values around the pixel
+// (+- 0.01), which shortens the trail of smaller changes.
 //
 // Each earlier frame enters with its own estimate, not its filtered result: a frame's output
 // depends on the estimates of the frames in its window and nothing older, so a chunk of a
