@@ -7,6 +7,8 @@
 #include <hwy/foreach_target.h>  // re-includes this file once per target
 #include <hwy/highway.h>
 
+#include "variants/frame_simd-inl.h"
+
 #ifndef SSAO_TEMPORAL_CARRY_ARGS
 #define SSAO_TEMPORAL_CARRY_ARGS
 #include <algorithm>
@@ -49,14 +51,13 @@ HWY_NOINLINE void carry_row(const CarryArgs& a, const float* depth, const float*
   const hn::RebindToSigned<decltype(df)> di;
   using VF = hn::Vec<decltype(df)>;
   const int lanes = int(hn::Lanes(df));
-  const VF zero = hn::Zero(df), one = hn::Set(df, 1.0f);
+  const VF one = hn::Set(df, 1.0f);
   const VF inf = hn::Set(df, std::numeric_limits<float>::infinity());
   const VF per_depth = hn::Set(df, a.here.orthographic ? 0.0f : 1.0f);
-  const VF there_perspective = hn::Set(df, a.there.orthographic ? 0.0f : 1.0f);
   VF m[12];
   for (int k = 0; k < 12; ++k) m[k] = hn::Set(df, a.to_entry[k]);
   const VF y_unit = hn::Set(df, (a.here.center_v - a.v) * a.here.scale_v);
-  const VF max_x = hn::Set(df, float(a.width)), max_y = hn::Set(df, float(a.height));
+  const LaneProjection<VF> there(a.there, a.width, a.height);
   const auto width = hn::Set(di, a.width);
   alignas(64) float stage[6][16];
   for (int i = 0; i < count; i += lanes) {
@@ -84,21 +85,11 @@ HWY_NOINLINE void carry_row(const CarryArgs& a, const float* depth, const float*
     const VF py = y_unit * scale, pz = hn::Neg(safe);
     const VF qx = hn::MulAdd(m[0], px, hn::MulAdd(m[1], py, hn::MulAdd(m[2], pz, m[3])));
     const VF qy = hn::MulAdd(m[4], px, hn::MulAdd(m[5], py, hn::MulAdd(m[6], pz, m[7])));
-    const VF z = hn::Neg(hn::MulAdd(m[8], px, hn::MulAdd(m[9], py, hn::MulAdd(m[10], pz, m[11]))));
-    const auto in_front = hn::Or(hn::Gt(z, zero), hn::Eq(there_perspective, zero));
-    const VF divisor =
-        hn::MulAdd(there_perspective, hn::IfThenElse(in_front, z, one), one - there_perspective);
-    // 1 / divisor: the hardware estimate refined by one Newton step (as LaneProjection does).
-    const VF estimate = hn::ApproximateReciprocal(divisor);
-    const VF inv = estimate * hn::NegMulAdd(divisor, estimate, hn::Set(df, 2.0f));
+    const VF qz = hn::MulAdd(m[8], px, hn::MulAdd(m[9], py, hn::MulAdd(m[10], pz, m[11])));
+    const VF z = hn::Neg(qz);  // planar depth there
     // The point's continuous image coordinates in the earlier frame, and the pixel there.
-    const VF fx =
-        hn::MulAdd(qx * inv, hn::Set(df, 1.0f / a.there.scale_u), hn::Set(df, a.there.center_u));
-    const VF fy =
-        hn::NegMulAdd(qy * inv, hn::Set(df, 1.0f / a.there.scale_v), hn::Set(df, a.there.center_v));
-    const auto inside =
-        hn::And(hn::And(in_front, geometry), hn::And(hn::And(hn::Ge(fx, zero), hn::Lt(fx, max_x)),
-                                                     hn::And(hn::Ge(fy, zero), hn::Lt(fy, max_y))));
+    VF fx, fy;
+    const auto inside = hn::And(there(qx, qy, qz, fx, fy), geometry);
     const auto x = hn::ConvertTo(di, hn::IfThenElseZero(inside, fx));
     const auto y = hn::ConvertTo(di, hn::IfThenElseZero(inside, fy));
     const auto index = y * width + x;
