@@ -206,6 +206,152 @@ def build_geometry(scene):
     add_sphere(scene, "Sphere", 0.5, (1.2, -0.35, 0.5), mat)
 
 
+def _math(tree, operation, a, b=None):
+    """A Math node of `operation` on a (and b): sockets are linked, numbers are set."""
+    node = tree.nodes.new("ShaderNodeMath")
+    node.operation = operation
+    for socket, value in zip(node.inputs, (a, b)):
+        if value is None:
+            continue
+        if isinstance(value, (int, float)):
+            socket.default_value = value
+        else:
+            tree.links.new(value, socket)
+    return node.outputs[0]
+
+
+def cutout_material(name, kind):
+    """Grey diffuse with an alpha cut-out, as artists make them: `lattice` is a Mix Shader of
+    a Transparent BSDF and the diffuse by a mask of slats (a third of the card solid); `leaf`
+    is a Principled BSDF whose Alpha is an ellipse inscribed in the card."""
+    mat = bpy.data.materials.new(name)
+    mat.use_nodes = True
+    tree = mat.node_tree
+    tree.nodes.clear()
+    out = tree.nodes.new("ShaderNodeOutputMaterial")
+    coords = tree.nodes.new("ShaderNodeTexCoord")
+    xyz = tree.nodes.new("ShaderNodeSeparateXYZ")
+    tree.links.new(coords.outputs["UV"], xyz.inputs[0])
+    u, v = xyz.outputs["X"], xyz.outputs["Y"]
+    if kind == "lattice":
+        # Slats along both axes: solid where either fraction is below 0.18 (about a third).
+        slat_u = _math(tree, 'LESS_THAN', _math(tree, 'FRACT', _math(tree, 'MULTIPLY', u, 9.0)),
+                       0.18)
+        slat_v = _math(tree, 'LESS_THAN', _math(tree, 'FRACT', _math(tree, 'MULTIPLY', v, 6.0)),
+                       0.18)
+        alpha = _math(tree, 'MAXIMUM', slat_u, slat_v)
+        diffuse = tree.nodes.new("ShaderNodeBsdfDiffuse")
+        diffuse.inputs["Color"].default_value = GREY
+        mix = tree.nodes.new("ShaderNodeMixShader")
+        tree.links.new(alpha, mix.inputs["Fac"])
+        tree.links.new(tree.nodes.new("ShaderNodeBsdfTransparent").outputs[0], mix.inputs[1])
+        tree.links.new(diffuse.outputs[0], mix.inputs[2])
+        tree.links.new(mix.outputs[0], out.inputs["Surface"])
+    else:
+        du = _math(tree, 'SUBTRACT', u, 0.5)
+        dv = _math(tree, 'SUBTRACT', v, 0.5)
+        radius = _math(tree, 'ADD', _math(tree, 'MULTIPLY', du, du),
+                       _math(tree, 'MULTIPLY', _math(tree, 'MULTIPLY', dv, dv), 0.45))
+        alpha = _math(tree, 'LESS_THAN', radius, 0.25 * 0.45)
+        bsdf = tree.nodes.new("ShaderNodeBsdfPrincipled")
+        bsdf.inputs["Base Color"].default_value = GREY
+        tree.links.new(alpha, bsdf.inputs["Alpha"])
+        tree.links.new(bsdf.outputs[0], out.inputs["Surface"])
+    mat.diffuse_color = GREY
+    return mat
+
+
+def add_card(scene, name, size, center, rotation, material):
+    """A single plane (no thickness, no back face of its own) of `size` (x, y) with UVs over
+    [0, 1], rotated by the Euler angles `rotation` (degrees) about its centre."""
+    bm = bmesh.new()
+    bm.loops.layers.uv.new("UVMap")  # create_grid fills it (calc_uvs)
+    bmesh.ops.create_grid(bm, x_segments=1, y_segments=1, size=0.5, calc_uvs=True)
+    bmesh.ops.scale(bm, vec=(size[0], size[1], 1.0), verts=bm.verts)
+    obj = add_bmesh_object(scene, name, bm, material, smooth=False)
+    obj.rotation_euler = Euler([math.radians(a) for a in rotation])
+    obj.location = Vector(center)
+    return obj
+
+
+def add_curtain(scene, name, width, height, center, material, folds=5, depth=0.12):
+    """An open, folded sheet hanging in the XZ plane (a curtain): a grid waved along X."""
+    bm = bmesh.new()
+    bm.loops.layers.uv.new("UVMap")
+    bmesh.ops.create_grid(bm, x_segments=60, y_segments=12, size=0.5, calc_uvs=True)
+    for vert in bm.verts:
+        x, y = vert.co.x * width, vert.co.y * height
+        vert.co = Vector((x, depth * math.sin(2.0 * math.pi * folds * (x / width + 0.5)), y))
+    bmesh.ops.translate(bm, vec=Vector(center), verts=bm.verts)
+    return add_bmesh_object(scene, name, bm, material, smooth=True)
+
+
+def build_cutouts(scene):
+    """Open surfaces with alpha cut-outs, as real scenes have them (issue 33): a lattice fence
+    (one plane, two thirds of it holes) 1 m in front of the wall, leaf cards facing the camera
+    or away from it (single planes, alpha-cut ellipses), and a folded curtain (an open sheet)."""
+    lattice = cutout_material("Lattice", "lattice")
+    leaf = cutout_material("Leaf", "leaf")
+    grey = bpy.data.materials.get("Grey") or grey_material()
+    add_card(scene, "Fence", (4.0, 1.4), (-1.3, WALL_Y - 1.0, 0.7), (90.0, 0.0, 0.0), lattice)
+    for index, (center, rotation) in enumerate((
+            ((-0.9, 1.6, 1.45), (70.0, 0.0, 25.0)),     # front towards the camera
+            ((-0.55, 1.45, 1.25), (110.0, 0.0, -30.0)),  # seen from its back
+            ((0.25, 1.7, 1.55), (80.0, 15.0, 160.0)),   # seen from its back
+            ((1.95, 0.2, 0.25), (20.0, 0.0, 40.0)),     # lying near the floor
+            ((-0.15, -0.15, 0.95), (60.0, 0.0, -15.0)))):
+        add_card(scene, f"Leaf{index}", (0.45, 0.3), center, rotation, leaf)
+    add_curtain(scene, "Curtain", 1.4, 1.6, (2.9, 1.5, 0.85), grey)
+
+
+def build_render_features(scene):
+    """What decides which surface a camera ray meets besides the geometry (issue 33): alpha
+    cut-outs under each blend method (Cycles ignores it), material displacement that moves the
+    surface, a holdout object, an object hidden from the camera, and a collection that is a
+    holdout in the view layer. Adds the cut-outs of build_cutouts."""
+    build_cutouts(scene)
+    for material, method in ((bpy.data.materials["Lattice"], 'HASHED'),
+                             (bpy.data.materials["Leaf"], 'BLEND')):
+        try:  # EEVEE's setting; 4.2+ keeps it for files but may refuse some values
+            material.blend_method = method
+        except (AttributeError, TypeError):
+            pass
+    # A plane of ripples made by the material's displacement alone (Cycles' true
+    # displacement on a finely divided grid).
+    bumpy = bpy.data.materials.new("Displaced")
+    bumpy.use_nodes = True
+    tree = bumpy.node_tree
+    out = next(n for n in tree.nodes if n.bl_idname == "ShaderNodeOutputMaterial")
+    wave = tree.nodes.new("ShaderNodeTexWave")
+    wave.inputs["Scale"].default_value = 3.0
+    displacement = tree.nodes.new("ShaderNodeDisplacement")
+    displacement.inputs["Scale"].default_value = 0.25
+    displacement.inputs["Midlevel"].default_value = 0.0
+    tree.links.new(wave.outputs["Fac"], displacement.inputs["Height"])
+    tree.links.new(displacement.outputs[0], out.inputs["Displacement"])
+    if hasattr(bumpy, "displacement_method"):
+        bumpy.displacement_method = 'DISPLACEMENT'
+    else:
+        bumpy.cycles.displacement_method = 'DISPLACEMENT'
+    bm = bmesh.new()
+    bm.loops.layers.uv.new("UVMap")
+    bmesh.ops.create_grid(bm, x_segments=96, y_segments=96, size=0.7, calc_uvs=True)
+    bmesh.ops.translate(bm, vec=Vector((2.3, -1.4, 0.02)), verts=bm.verts)
+    add_bmesh_object(scene, "Displaced", bm, bumpy, smooth=True)
+    grey = bpy.data.materials["Grey"]
+    holdout = add_sphere(scene, "Holdout", 0.3, (0.3, -1.3, 0.3), grey, segments=24, rings=12)
+    holdout.is_holdout = True
+    hidden = add_box(scene, "HiddenFromCamera", (0.6, 0.6, 0.6), (-1.0, -1.6, 0.3), grey)
+    hidden.visible_camera = False
+    collection = bpy.data.collections.new("HoldoutCollection")
+    scene.collection.children.link(collection)
+    box = add_box(scene, "InHoldoutCollection", (0.4, 0.4, 0.9), (2.0, 1.2, 0.45), grey)
+    scene.collection.objects.unlink(box)
+    collection.objects.link(box)
+    for layer in scene.view_layers:
+        layer.layer_collection.children[collection.name].holdout = True
+
+
 def setup_world(scene, ao_distance):
     world = scene.world
     if world is None:

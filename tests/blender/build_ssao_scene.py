@@ -5,7 +5,7 @@ Ambient Occlusion (SSAO) node in the compositor and saves it as a .blend.
     blender -b --factory-startup --addons ssao_compositor --python-exit-code 1 \
         -P tests/blender/build_ssao_scene.py -- --out scene.blend [--engine cycles|eevee]
         [--camera persp|ortho] [--width 160 --height 90 --samples 16] [--frames 1]
-        [--output //render_####.png] [--ao-pass] [--radius 0.8]
+        [--output //render_####.png] [--ao-pass] [--radius 0.8] [--cutouts | --render-features]
 
 The compositor: Render Layers (Image, Depth, Normal) -> SSAO -> Composite (Group Output in 5.x);
 the SSAO node's AO output also goes to a Viewer. With --frames N the camera moves and turns
@@ -44,6 +44,13 @@ def parse_args():
                         help="the node's hidden_surfaces (default: the node's default)")
     parser.add_argument("--overscan", type=int, default=None,
                         help="the node's overscan in pixels (default: the node's default)")
+    parser.add_argument("--cutouts", action="store_true",
+                        help="add open surfaces with alpha cut-outs: a lattice fence, leaf "
+                             "cards, a curtain (make_reference_scene.build_cutouts)")
+    parser.add_argument("--render-features", action="store_true",
+                        help="--cutouts, and material displacement, holdouts (an object, a "
+                             "collection) and an object hidden from the camera "
+                             "(make_reference_scene.build_render_features)")
     parser.add_argument("--passes-dir", default=None,
                         help="also write Image, Depth, Normal (and AO) of every frame to "
                              "DIR/####.exr with a top-level File Output node")
@@ -66,6 +73,10 @@ def main():
     scene = bpy.context.scene
     reference.clear_scene(scene)
     reference.build_geometry(scene)
+    if args.render_features:
+        reference.build_render_features(scene)
+    elif args.cutouts:
+        reference.build_cutouts(scene)
     reference.setup_world(scene, args.radius)
     reference.add_sun(scene)
     camera = reference.add_camera(scene, args.camera)
