@@ -9,6 +9,16 @@ from . import compat, compute, handlers, inner_tree, recomposite, ssao
 LIBRARY_ERROR = None
 # Variant name -> the parameters only it reads (the node hides them for other variants).
 VARIANT_PARAMETERS = {}
+# Parameter name -> its library group (ssao_param_group: compute.NODE_GROUPS), for the sidebar.
+PARAMETER_GROUPS = {}
+# The node's face (draw_buttons): what an artist changes, as on Blender's own nodes; with the
+# add-on's settings (compute.NODE_SETTINGS), Recompute and the status. The sidebar (N panel,
+# Node tab: draw_buttons_ext) shows every property, grouped as the library groups them.
+FACE_PARAMETERS = ("radius", "strength", "quality")
+# The sidebar's box titles: the library's groups, in compute.NODE_GROUPS's order, then the
+# add-on's settings.
+GROUP_TITLES = {"ao": "Occlusion", "quality": "Quality and cost", "shaping": "Shaping"}
+SETTINGS_TITLE = "Helper render"
 # Chosen from the costs and gains measured in docs/blender.md, "Hidden surfaces and overscan".
 DEFAULT_HIDDEN_SURFACES = 'PEELED'
 DEFAULT_OVERSCAN = 64
@@ -41,10 +51,28 @@ def _property_for(desc):
                                    update=_on_parameter_changed, **kwargs)
 
 
+def _draw_property(node, layout, name, stacked=False):
+    """A property. A menu gets its name on the left half, or on a line above it when `stacked`
+    (the sidebar, narrower than the node): Blender's own "Name: value" leaves a few letters
+    of the name in either."""
+    prop = node.bl_rna.properties[name]
+    if prop.type != 'ENUM':
+        layout.prop(node, name)
+    elif stacked:
+        column = layout.column(align=True)
+        column.label(text=prop.name)
+        column.prop(node, name, text="")
+    else:
+        split = layout.split(factor=0.5)
+        split.label(text=prop.name)
+        split.prop(node, name, text="")
+
+
 def _parameter_table():
     global LIBRARY_ERROR
     try:
         table = {p["name"]: p for p in ssao.parameters(compute.library())}
+        PARAMETER_GROUPS.update({name: p["group"] for name, p in table.items()})
         VARIANT_PARAMETERS.update({v["name"]: set(v["parameters"])
                                    for v in ssao.variants(compute.library())})
     except Exception as error:  # the node must still register so .blend files open
@@ -100,24 +128,62 @@ class CompositorNodeSSAO(bpy.types.CompositorNodeCustomGroup):
         if self.node_tree is not None and self.node_tree.users <= 1:
             bpy.data.node_groups.remove(self.node_tree)
 
-    def draw_buttons(self, context, layout):
+    def shown_parameters(self):
+        """The library parameters the node shows, in the table's order: those its variant
+        reads (the library lists them, ssao_variant_info) and those every variant reads."""
         if LIBRARY_ERROR:
-            layout.label(text="libssao missing (see console)", icon='ERROR')
-        shown = set(compute.node_parameter_names()) if not LIBRARY_ERROR else set()
+            return []
         variant_specific = set().union(*VARIANT_PARAMETERS.values())
         active = VARIANT_PARAMETERS.get(getattr(self, "variant", ""), variant_specific)
-        for name in self.bl_rna.properties.keys():
-            if name in shown and (name not in variant_specific or name in active):
-                layout.prop(self, name)
-        for name in compute.NODE_SETTINGS:
-            layout.prop(self, name)
+        return [name for name in compute.node_parameter_names()
+                if name in self.bl_rna.properties and
+                (name not in variant_specific or name in active)]
+
+    def _draw_problems(self, context, layout):
+        if LIBRARY_ERROR:
+            layout.label(text="libssao missing (see console)", icon='ERROR')
         problem = context.scene and compat.compositor_cannot_export(context.scene)
         if problem:
             layout.label(text="GPU compositor: set the compositor device to CPU", icon='ERROR')
+
+    def _draw_recompute_and_status(self, layout):
         layout.operator("ssao.recompute", icon='FILE_REFRESH')
         if self.status:
             layout.label(text=self.status, icon='ERROR' if self.status.startswith("Error")
                          else 'INFO')
+
+    def draw_buttons(self, context, layout):
+        """The node's face: radius, strength, quality, the add-on's settings, the status."""
+        self._draw_problems(context, layout)
+        shown = self.shown_parameters()
+        for name in FACE_PARAMETERS:
+            if name in shown:
+                _draw_property(self, layout, name)
+        for name in compute.NODE_SETTINGS:
+            _draw_property(self, layout, name)
+        self._draw_recompute_and_status(layout)
+
+    def draw_buttons_ext(self, context, layout):
+        """The sidebar (N panel, Node tab, Properties): every property, a box per library
+        group, then the add-on's settings."""
+        self._draw_problems(context, layout)
+        shown = self.shown_parameters()
+        groups = list(compute.NODE_GROUPS)
+        groups += sorted({PARAMETER_GROUPS.get(name, "") for name in shown} - set(groups))
+        for group in groups:  # a group the add-on does not know yet comes after its own
+            names = [name for name in shown if PARAMETER_GROUPS.get(name, "") == group]
+            if names:
+                box = layout.box()
+                box.label(text=GROUP_TITLES.get(group, group.capitalize() or "Other"))
+                column = box.column()
+                for name in names:
+                    _draw_property(self, column, name, stacked=True)
+        box = layout.box()
+        box.label(text=SETTINGS_TITLE)
+        column = box.column()
+        for name in compute.NODE_SETTINGS:
+            _draw_property(self, column, name, stacked=True)
+        self._draw_recompute_and_status(layout)
 
 
 def _draw_add_menu(self, context):

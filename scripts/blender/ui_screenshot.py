@@ -7,7 +7,7 @@ a screenshot of the window.
         --addons ssao_compositor SCENE.blend --python scripts/blender/ui_screenshot.py -- \
         --out DIR [--workspace Compositing|Layout] [--render-display SPLIT|WINDOW|NONE]
         [--after-workspace NAME] [--change radius=1.5] [--compositor-device CPU|GPU]
-        [--timeout 240]
+        [--sidebar] [--timeout 240]
 
 With the add-on installed as an extension (4.2+; e.g. Blender 5.2 through
 scripts/blender/blender52.sh), enable it as --addons bl_ext.user_default.ssao_compositor.
@@ -28,6 +28,12 @@ Everything runs from timers once the UI is up:
      renders into it (preferences: render in "Keep User Interface"); WINDOW is Blender's
      default (F12 opens a new window with an Image Editor); NONE renders with no Image Editor.
      The SSAO node is selected and the node tree framed (its properties are on the node).
+     --sidebar opens the compositor editor's sidebar (N panel) on its Node tab, whose
+     Properties panel shows the active node's draw_buttons_ext (3.4 closes that panel by
+     default: the script registers Blender's panel class again without DEFAULT_CLOSED). In
+     3.4 choosing the tab needs Blender's --enable-event-simulate (a simulated click; real
+     input, such as Xvfb's pointer in the middle of the screen, is then ignored: with it, no
+     tooltip shows in the screenshots).
      --compositor-device sets the scene's compositor device first (4.2+; 5.2's default is
      GPU; 3.4 has only the CPU one); the report says which one ran.
   2. F12: bpy.ops.render.render('INVOKE_DEFAULT'); waits for the render job, then for the
@@ -87,6 +93,8 @@ def parse_args():
                         help="NAME=VALUE node property to change after the render ('' skips)")
     parser.add_argument("--compositor-device", choices=("CPU", "GPU"), default=None,
                         help="set scene.render.compositor_device (4.2+); default: the file's")
+    parser.add_argument("--sidebar", action="store_true",
+                        help="open the compositor editor's sidebar on its Node tab")
     parser.add_argument("--timeout", type=float, default=240.0, help="seconds for everything")
     parser.add_argument("--settle", type=float, default=2.0,
                         help="seconds without compositor activity that count as done")
@@ -151,17 +159,70 @@ def ssao_node(scene):
     return nodes[0]
 
 
-def tidy_node_editor(window):
-    """No backdrop, no sidebar, no asset shelf (4.x/5.x). Region sizes change at the next
-    redraw, which shifts the view: frame the tree in a later timer step."""
+def tidy_node_editor(window, node):
+    """No backdrop, no sidebar (unless --sidebar), no asset shelf (4.x/5.x). Region sizes change
+    at the next redraw, which shifts the view: frame the tree in a later timer step."""
     area = find_area(window, "CompositorNodeTree")
     if area is not None:
         space = area.spaces.active
         space.show_backdrop = False
-        space.show_region_ui = False
+        if ARGS.sidebar:
+            open_node_properties_panel()
+            node.id_data.nodes.active = node  # the Node tab shows the active node
+        space.show_region_ui = ARGS.sidebar
         if hasattr(space, "show_region_asset_shelf"):
             space.show_region_asset_shelf = False
     return area is not None
+
+
+def open_node_properties_panel():
+    """Blender 3.4's Node tab has its Properties panel (the active node's draw_buttons_ext)
+    closed by default (bl_options DEFAULT_CLOSED; 4.x and 5.x open) and no Python API opens
+    a panel: the class is registered again without that option, before the sidebar first
+    draws."""
+    panel = getattr(bpy.types, "NODE_PT_active_node_properties", None)
+    if panel is None or 'DEFAULT_CLOSED' not in getattr(panel, "bl_options", ()):
+        return
+    bpy.utils.unregister_class(panel)
+    panel.bl_options = set(panel.bl_options) - {'DEFAULT_CLOSED'}
+    bpy.utils.register_class(panel)
+
+
+def sidebar_on_node_tab(window):
+    """Generator step: the compositor editor's sidebar on its Node tab. 5.2 chooses tabs from
+    Python (Region.active_panel_category). 3.4 cannot, and its factory startup file opens
+    the sidebar on the Tool tab: the script clicks the Node tab (the top one, at the region's
+    right edge) when Blender runs with --enable-event-simulate (Window.event_simulate; the
+    pointer must have moved there in an earlier event loop). REPORT["sidebar_tab"] says
+    how the tab was chosen."""
+    area = find_area(window, "CompositorNodeTree")
+    region = next((r for r in area.regions if r.type == 'UI'), None) if area else None
+    if region is None or region.width <= 1:
+        REPORT["sidebar_tab"] = "no sidebar"
+    elif hasattr(region, "active_panel_category"):
+        try:
+            region.active_panel_category = "Node"
+            REPORT["sidebar_tab"] = region.active_panel_category
+        except (TypeError, AttributeError, ValueError) as error:
+            REPORT["sidebar_tab"] = f"cannot choose the Node tab: {error}"
+    elif not bpy.app.use_event_simulate:
+        REPORT["sidebar_tab"] = "not chosen (3.4: run Blender with --enable-event-simulate)"
+    else:
+        scale = bpy.context.preferences.system.ui_scale
+        x = region.x + region.width - round(10 * scale)
+        y = region.y + region.height - round(30 * scale)
+        window.event_simulate(type='MOUSEMOVE', value='NOTHING', x=x, y=y)
+        yield 0.3
+        window.event_simulate(type='LEFTMOUSE', value='PRESS', x=x, y=y)
+        yield 0.1
+        window.event_simulate(type='LEFTMOUSE', value='RELEASE', x=x, y=y)
+        yield 0.3
+        REPORT["sidebar_tab"] = f"clicked at ({x}, {y}) in the window"
+    if area is not None and bpy.app.use_event_simulate:
+        # the pointer to an empty spot of the editor: no tooltip in the screenshots
+        window.event_simulate(type='MOUSEMOVE', value='NOTHING', x=area.x + 40, y=area.y + 40)
+        yield 0.3
+    log(f"sidebar tab: {REPORT['sidebar_tab']}")
 
 
 def preview_height(node):
@@ -535,8 +596,11 @@ def scenario():
     else:
         prefs.view.render_display_type = ARGS.render_display
     yield 0.5
-    tidy_node_editor(window)
+    tidy_node_editor(window, node)
     yield 0.5
+    if ARGS.sidebar:
+        yield 0.5
+        yield from sidebar_on_node_tab(window)
     REPORT["compositor_editor_open"] = frame_node_tree(window, node)
     REPORT["status_before"] = node.status
     yield 0.5
