@@ -119,7 +119,18 @@ def configure_node(node, folder=None):
 
 
 def read_export(path):
-    """The exported passes as a bottom-up (height, width, 4) float32 array."""
+    """The exported passes as a bottom-up float32 array (height, width, 4): normal xyz, depth;
+    (height, width, 5) with the Image's alpha when it was exported with them (the composite's
+    coverage on a transparent film; inner_tree.py)."""
+    passes = _read_rgba(path)
+    alpha_path = inner_tree.alpha_export_path(path)
+    alpha = _read_rgba(alpha_path) if alpha_path is not None else None
+    if alpha is None or alpha.shape != passes.shape:
+        return passes
+    return np.concatenate([passes, alpha[:, :, :1]], axis=2)
+
+
+def _read_rgba(path):
     image = bpy.data.images.load(path, check_existing=False)
     try:
         image.colorspace_settings.name = 'Non-Color'
@@ -274,9 +285,10 @@ def threads(scene):
 
 
 def compute_node(node, scene, passes):
-    """AO of `node` from exported `passes` (bottom-up RGBA: normal xyz, depth); fills the node's
-    AO image and returns the AO with row 0 on top. Raises, leaving the AO image as it was, when
-    the inputs, the parameters or the library cannot give this frame's AO."""
+    """AO of `node` from exported `passes` (read_export's: normal xyz, depth[, the Image's
+    alpha]); fills the node's AO image (with the composite's factor: inner_tree.py) and returns
+    the AO with row 0 on top. Raises, leaving the AO image as it was, when the inputs, the
+    parameters or the library cannot give this frame's AO."""
     use_normals = check_inputs(node)
     check_parameters(node)
     lib = library()  # before the helper render (library_inputs): a missing library renders none
@@ -286,8 +298,7 @@ def compute_node(node, scene, passes):
     check_depth(passes[:, :, 3])
     if use_normals:
         check_normals(scene, passes, min(background, camera["clip_end"] or math.inf))
-    height, width = passes.shape[:2]
-    rgba = np.empty((height, width, 4), np.float32)
+    rgba, outputs = inner_tree.library_outputs(passes)
     # Blender's rows run bottom-up, the library's top-down: flipped views read in place.
     images, overscan = library_inputs(node, scene, passes, use_normals)
     with ssao.Job(lib) as job:
@@ -301,14 +312,10 @@ def compute_node(node, scene, passes):
             job.set_image(name, image)
         if overscan:
             job.set_output_window(overscan, overscan)
-        job.set_image("ao", rgba[::-1])
+        for name, image in outputs.items():
+            job.set_image(name, image)
         job.run()
-    image = inner_tree.ao_image(node, width, height)
-    image.pixels.foreach_set(rgba.ravel())
-    image.update()
-    # 5.x's GPU compositor keeps its own copy of the image: tag it, or the UI compositor
-    # re-composites with the old AO (measured in 5.2.2).
-    image.update_tag()
+    inner_tree.store_outputs(node, rgba, outputs)
     return np.ascontiguousarray(rgba[::-1, :, 0])
 
 

@@ -6,8 +6,17 @@ composites (with the last computed AO) where the add-on is not installed:
     Normal -> Separate Color -> R, G, B ┐
     Depth  ------------------------> A  ┴ Combine Color -> File Output "SSAO Export"
                                           (a lossless 32-bit EXR, read back by compute.py)
-  Image node "SSAO AO" (the AO, filled by compute.py) -> Multiply with Image -> Output Image
-                                                     -> Output AO
+    Image  -> Separate Color "SSAO Image Alpha" -> Alpha -> File Output "SSAO Export Alpha"
+                                          (the same file name in the folder alpha/ beside it)
+  Image node "SSAO AO" (filled by compute.py) -> Separate Color "SSAO Channels"
+    Red:   the AO                                           -> Output AO
+    Green: the composite's factor -> Multiply with Image    -> Output Image
+
+The factor is libssao's composite of a white image with the Image's alpha: the AO, except on a
+silhouette against the sky, where only the surface's share of the pixel is darkened (ssao.h,
+"composite"). The Image is multiplied by it in the compositor, so the Image output is the
+library's composite of the Image (the same float products) and follows changes upstream of the
+node without a recompute; the factor itself follows the Image's alpha of the last render.
 """
 import os
 import uuid
@@ -19,6 +28,13 @@ from . import compat
 
 NODE_IDNAME = "CompositorNodeSSAO"
 EXPORT_NODE, AO_NODE, MULTIPLY_NODE = "SSAO Export", "SSAO AO", "SSAO Multiply"
+# Added for the library's composite (issue 33); trees saved before get them in upgrade().
+CHANNELS_NODE, ALPHA_NODE, ALPHA_EXPORT_NODE = \
+    "SSAO Channels", "SSAO Image Alpha", "SSAO Export Alpha"
+ALPHA_FOLDER = "alpha"  # the alpha export's folder, inside the passes export's
+# The two exports are written by one compositor run: an alpha file older than its passes file
+# by more than this is from another render (and is not used).
+ALPHA_EXPORT_SLACK_SECONDS = 60.0
 
 
 def build(ssao_id):
@@ -52,16 +68,71 @@ def build(ssao_id):
 
     ao = nodes.new("CompositorNodeImage")
     ao.name = ao.label = AO_NODE
-    ao.location = (-150, 200)
+    ao.location = (-350, 200)
     multiply, factor, image_in, ao_in, result = compat.new_multiply(tree)
     multiply.name = multiply.label = MULTIPLY_NODE
     multiply.location = (150, 100)
     factor.default_value = 1.0
     links.new(group_in.outputs["Image"], image_in)
-    links.new(ao.outputs["Image"], ao_in)
     links.new(result, group_out.inputs["Image"])
-    links.new(ao.outputs["Image"], group_out.inputs["AO"])
+    _add_channels(tree, ao_in)
+    _add_alpha_export(tree)
     return tree
+
+
+def _group_nodes(tree):
+    return (next(n for n in tree.nodes if n.bl_idname == "NodeGroupInput"),
+            next(n for n in tree.nodes if n.bl_idname == "NodeGroupOutput"))
+
+
+def _add_channels(tree, factor_in):
+    """The AO image's Red to the AO output, its Green (the composite's factor) to the Multiply's
+    input `factor_in`: exact channels (a colour linked to a float socket is averaged)."""
+    ao = tree.nodes[AO_NODE]
+    _, group_out = _group_nodes(tree)
+    channels = tree.nodes.new("CompositorNodeSeparateColor")
+    channels.mode = 'RGB'
+    channels.name = channels.label = CHANNELS_NODE
+    channels.location = (-150, 200)
+    for link in list(ao.outputs["Image"].links):
+        tree.links.remove(link)
+    tree.links.new(ao.outputs["Image"], channels.inputs[0])
+    tree.links.new(channels.outputs["Green"], factor_in)
+    tree.links.new(channels.outputs["Red"], group_out.inputs["AO"])
+
+
+def _add_alpha_export(tree):
+    """The Image's alpha, written beside the passes (read back by compute.py: the composite's
+    coverage on a transparent film)."""
+    group_in, _ = _group_nodes(tree)
+    alpha = tree.nodes.new("CompositorNodeSeparateColor")
+    alpha.mode = 'RGB'
+    alpha.name = alpha.label = ALPHA_NODE
+    alpha.location = (-150, -450)
+    # Its one input has the exporter's name: 5.x names files file name + input name.
+    exporter = compat.new_file_output(tree, ["Passes"])
+    exporter.name = exporter.label = ALPHA_EXPORT_NODE
+    exporter.location = (100, -450)
+    tree.links.new(group_in.outputs["Image"], alpha.inputs[0])
+    tree.links.new(alpha.outputs["Alpha"], exporter.inputs[0])
+
+
+def upgrade(node):
+    """Adds what a tree saved by an earlier version of the add-on lacks (its AO image's Green is
+    the AO: it composites Image x AO until the next computation)."""
+    tree = node.node_tree
+    if tree is None or tree.library is not None or AO_NODE not in tree.nodes or \
+            MULTIPLY_NODE not in tree.nodes:
+        return
+    if CHANNELS_NODE not in tree.nodes:
+        # Before: the AO image's colour linked straight to the Multiply and the AO output.
+        multiplied = [link.to_socket for link in tree.nodes[AO_NODE].outputs["Image"].links
+                      if link.to_node == tree.nodes[MULTIPLY_NODE]]
+        if not multiplied:
+            return  # edited by hand: left alone
+        _add_channels(tree, multiplied[0])
+    if ALPHA_EXPORT_NODE not in tree.nodes:
+        _add_alpha_export(tree)
 
 
 def new_id():
@@ -87,32 +158,53 @@ def export_path(node, frame, extra_folders=(), since=0.0):
     return max(existing, key=os.path.getmtime) if existing else None
 
 
+def alpha_export_path(passes_path):
+    """The Image's alpha exported with the passes at `passes_path` (the same file name in the
+    folder alpha/ beside it), or None when no alpha was written with them."""
+    path = os.path.join(os.path.dirname(passes_path), ALPHA_FOLDER,
+                        os.path.basename(passes_path))
+    if not os.path.isfile(path) or os.path.getmtime(path) < \
+            os.path.getmtime(passes_path) - ALPHA_EXPORT_SLACK_SECONDS:
+        return None
+    return path
+
+
 def point_exporter(node, folder):
-    """Points the node's exporter at `folder` (no folder is made: File Output makes it when it
+    """Points the node's exporters at `folder` (no folder is made: File Output makes it when it
     first writes)."""
-    exporter = inner(node, EXPORT_NODE)
+    exporter, alpha = inner(node, EXPORT_NODE), inner(node, ALPHA_EXPORT_NODE)
     if exporter is not None:
         compat.set_file_output_target(exporter, folder, f"ssao_{node.ssao_id}_")
+    if alpha is not None:
+        compat.set_file_output_target(alpha, os.path.join(folder, ALPHA_FOLDER),
+                                      f"ssao_{node.ssao_id}_")
 
 
 def configure(node, folder, size=None):
-    """The exporter writes lossless 32-bit RGBA EXR into `folder`; the AO image exists (and has
-    `size`, when given)."""
+    """The tree upgraded (upgrade()); the exporter writes lossless 32-bit RGBA EXR into
+    `folder`, the alpha exporter 32-bit RGB (alpha in each channel) into its alpha/ folder; the
+    AO image exists (and has `size`, when given)."""
     exporter = inner(node, EXPORT_NODE)
     if exporter is None:
         return
+    upgrade(node)
     point_exporter(node, folder)
     compat.set_image_format(exporter.format, 'OPEN_EXR', color_depth='32', codec='ZIP',
                             color_mode='RGBA')
-    exporter.mute = False
+    alpha = inner(node, ALPHA_EXPORT_NODE)
+    if alpha is not None:
+        compat.set_image_format(alpha.format, 'OPEN_EXR', color_depth='32', codec='ZIP',
+                                color_mode='RGB')
+    set_exporter_muted(node, False)
     if size is not None:
         ao_image(node, *size)
 
 
 def set_exporter_muted(node, muted):
-    exporter = inner(node, EXPORT_NODE)
-    if exporter is not None:
-        exporter.mute = muted
+    for name in (EXPORT_NODE, ALPHA_EXPORT_NODE):
+        exporter = inner(node, name)
+        if exporter is not None:
+            exporter.mute = muted
 
 
 def forget_ao_image(node):
@@ -146,13 +238,43 @@ def ao_image(node, width, height):
     return image
 
 
+def library_outputs(passes):
+    """(pixels, {library image name: array, row 0 on top}) for a run on `passes` (compute.py's
+    bottom-up export: normal xyz, depth and, when it was exported, the Image's alpha): pixels
+    are the AO image's, bottom-up (height, width, 4); the run writes the AO into them ("ao")
+    and the composite of a white image with the Image's alpha into a buffer of its own
+    ("beauty", which is also the "composite"); store_outputs() then puts that factor into
+    Green."""
+    height, width = passes.shape[:2]
+    pixels = np.empty((height, width, 4), np.float32)
+    white = np.ones((height, width, 4), np.float32)  # row 0 on top
+    if passes.shape[2] > 4:
+        white[:, :, 3] = passes[::-1, :, 4]
+    return pixels, {"ao": pixels[::-1], "beauty": white, "composite": white}
+
+
+def store_outputs(node, pixels, outputs):
+    """The AO image's pixels after a run of library_outputs(): Red (and Blue) the AO, Green the
+    composite's factor, alpha 1; the image is filled and tagged. Returns it."""
+    pixels[:, :, 1] = outputs["composite"][::-1, :, 0]
+    height, width = pixels.shape[:2]
+    image = ao_image(node, width, height)
+    image.pixels.foreach_set(pixels.ravel())
+    image.update()
+    # 5.x's GPU compositor keeps its own copy of the image: tag it, or the UI compositor
+    # re-composites with the old AO (measured in 5.2.2).
+    image.update_tag()
+    return image
+
+
 def blank_ao(node, width, height):
-    """Sets the node's AO image to 1, so that the node passes its Image through unchanged: what
-    a frame whose AO could not be computed gets, rather than the AO of another frame."""
+    """Sets the node's AO image to 1 (the AO and the composite's factor), so that the node
+    passes its Image through unchanged: what a frame whose AO could not be computed gets,
+    rather than the AO of another frame."""
     image = ao_image(node, width, height)
     image.pixels.foreach_set(np.ones(width * height * 4, np.float32))
     image.update()
-    image.update_tag()  # 5.x's GPU compositor keeps its own copy (see compute.py)
+    image.update_tag()  # 5.x's GPU compositor keeps its own copy (see store_outputs)
 
 
 def nudge(node):

@@ -77,7 +77,9 @@ import zlib
 import bpy
 
 NODE_IDNAME = "CompositorNodeSSAO"
-AGREEMENT = 1e-3  # max |Composite - Combined x AO| for "AO applied" (float EXR, linear)
+# max |Composite - Combined x AO| for "AO applied" (float EXR, linear), the AO as the node
+# composites it: lighter on silhouettes against the sky (the factor of node_ao's channel 1).
+AGREEMENT = 1e-3
 
 
 def parse_args():
@@ -504,19 +506,21 @@ def save_render_result(scene, path):
     addon_module("recomposite").save_passes(scene, path)
 
 
-def node_ao(node):
-    """The node's AO image as (height, width), row 0 on top."""
+def node_ao(node, channel=0):
+    """The node's AO image as (height, width), row 0 on top: channel 0 the AO, 1 the factor
+    the node multiplies its Image by (the AO, lighter on silhouettes against the sky)."""
     import numpy as np
     image = node.node_tree.nodes["SSAO AO"].image
     width, height = image.size
     pixels = np.empty(width * height * 4, np.float32)
     image.pixels.foreach_get(pixels)
-    return pixels.reshape(height, width, 4)[::-1, :, 0].copy()
+    return pixels.reshape(height, width, 4)[::-1, :, channel].copy()
 
 
-def compare(exr_path, ao):
-    """Composite vs Combined and vs Combined x AO, from a multilayer Render Result EXR (read
-    with the add-on's reader: every part of 5.x's multi-part files)."""
+def compare(exr_path, ao, factor=None):
+    """Composite vs Combined and vs Combined x AO (x `factor`, the node's, when given), from a
+    multilayer Render Result EXR (read with the add-on's reader: every part of 5.x's
+    multi-part files)."""
     import numpy as np
     planes, _ = addon_module("multilayer").read(exr_path)  # {channel: (h, w)}, row 0 on top
     names = list(planes)
@@ -536,7 +540,7 @@ def compare(exr_path, ao):
     if composite.shape != ao.shape + (3,):
         result["error"] = f"Composite is {composite.shape[:2]}, the AO {ao.shape}"
         return result
-    product = combined * ao[:, :, None]
+    product = combined * (ao if factor is None else factor)[:, :, None]
     result.update({
         "max_abs_composite_minus_combined": float(np.abs(composite - combined).max()),
         "max_abs_composite_minus_combined_x_ao": float(np.abs(composite - product).max()),
@@ -672,7 +676,7 @@ def check(label, scene, node, since):
     save_render_result(scene, path)
     ao = node_ao(node)
     np.save(os.path.join(OUT, f"ao_{label}.npy"), ao)
-    result = compare(path, ao)
+    result = compare(path, ao, node_ao(node, channel=1))
     result["compositor_jobs_since"] = count("composite_post", since)
     log(f"{label}: {json.dumps(result)}")
     return result
