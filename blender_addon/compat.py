@@ -237,3 +237,11 @@ def layer_collection(view_layer):
     if view_layer.layer_collection is None:
         view_layer.update()
     return view_layer.layer_collection
+
+
+def displacement_method(material):
+    """'BUMP', 'DISPLACEMENT' or 'BOTH': material.displacement_method in 4.1+, its Cycles
+    settings' before."""
+    if hasattr(material, "displacement_method"):
+        return material.displacement_method
+    return material.cycles.displacement_method

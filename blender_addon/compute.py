@@ -44,6 +44,9 @@ def node_parameter_names():
 # The node's own settings (not library parameters): what the add-on renders for the library
 # beyond the user's passes (hidden_surfaces.py). Saved with the node's parameters.
 NODE_SETTINGS = ("hidden_surfaces", "overscan")
+# Relative depth difference within which the helper's surface and the user's are one (measured:
+# 1.2e-6 between Cycles' Depth pass and the helper's; docs/blender.md).
+SAME_SURFACE = 1e-4
 # hidden_surfaces -> surface hits per pixel the helper render records.
 HITS = {'NONE': 1, 'PEELED': 3}
 
@@ -345,14 +348,16 @@ def library_inputs(node, scene, passes, use_normals):
 
 def _extra_layers(depth, layers, hits):
     """depth2.. and facing2.. behind the depth the library is given: the helper's 2nd and
-    later hits that lie behind it. Inside the frame that depth is the user's pass, which can
-    disagree with the helper's 1st hit (EEVEE's half floats, alpha cut-outs, displacement that
-    the helper's material override drops): a hit not behind it is dropped and the later ones
-    move up, so the layers stay in depth order (the library refuses a layer nearer than the
-    one before it)."""
+    later surfaces that lie behind it (an open surface's twin lies at its own depth: within
+    SAME_SURFACE counts as behind). Inside the frame that depth is the user's pass, which can
+    disagree with the helper's 1st surface (EEVEE's half floats, a surface the helper does not
+    see as the beauty does): an entry not behind it is dropped and the later ones move up, so
+    the layers stay in depth order (the library refuses a layer nearer than the one before
+    it)."""
     behind = np.stack([layers[f"depth{k}"] for k in range(2, hits + 1)])
     facing = np.stack([layers[f"facing{k}"] for k in range(2, hits + 1)])
-    behind = np.where(behind > depth, behind, np.float32(np.inf))
+    behind = np.where(behind >= depth * np.float32(1.0 - SAME_SURFACE), behind,
+                      np.float32(np.inf))
     order = np.argsort(behind, axis=0, kind="stable")
     behind = np.take_along_axis(behind, order, axis=0)
     facing = np.take_along_axis(facing, order, axis=0)

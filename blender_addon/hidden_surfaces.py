@@ -28,7 +28,16 @@ from . import compat, multilayer
 HELPER_PREFIX = ".SSAO layers "
 LAYER_NAME = "SSAO layers"
 MATERIAL_NAME = ".SSAO layers override"
+GROUP_NAME = ".SSAO layers hits"
+# The custom property that marks a holdout object while the helper renders (_Holdouts).
+HOLDOUT_PROPERTY = "ssao_helper_holdout"
 MAX_HITS = 3
+# The open-surface test (_hits_group): inside rays per surface, and how far they look (scene
+# units; a closed mesh is met within its own size).
+OPEN_SAMPLES = 4
+# Transparent depths recorded beyond `hits` (_slots).
+EXTRA_SLOTS = 1
+OPEN_DISTANCE = 1e4
 BACKGROUND = 1e10  # Cycles' Depth pass where there is no surface, Blender's convention
 
 _running = False  # our helper render fires the render handlers too
@@ -50,57 +59,289 @@ def forget(scene_name=None):
         _cache.pop(scene_name, None)
 
 
+def _slots(hits):
+    """Transparent depths the helper records: `hits` surfaces, plus room for an alpha hole
+    passed before them (each takes a transparent bounce). More room (3) changed nothing on the
+    cut-out scene (docs/blender.md) and costs shading."""
+    return hits + EXTRA_SLOTS
+
+
 def _aov_names(hits):
-    return [f"depth{k}" for k in range(1, hits + 1)] + \
-        [f"facing{k}" for k in range(2, hits + 1)] + ["normal"]
+    return [f"hit{j}" for j in range(_slots(hits))] + ["open", "stop", "normal"]
 
 
-def _override_material(hits):
-    """Transparent everywhere; AOVs depth<k>, facing<k> (k >= 2) and normal (hit 1) written at
-    hit k. Remade when it was made for fewer hits."""
-    material = bpy.data.materials.get(MATERIAL_NAME)
-    if material is not None and material.get("ssao_hits", 0) >= hits:
-        return material
-    if material is None:
-        material = bpy.data.materials.new(MATERIAL_NAME)
-    material["ssao_hits"] = hits
-    material.use_nodes = True
-    nodes, links = material.node_tree.nodes, material.node_tree.links
+def _alpha_threshold(scene):
+    """Cycles writes a pixel's Depth and Normal at the first surface whose alpha is at least the
+    view layer's Alpha Threshold (0: the first surface, whatever its alpha)."""
+    return float(getattr(_view_layer(scene), "pass_alpha_threshold", 0.5))
+
+
+def _hits_group(hits, threshold):
+    """The node group every helper surface runs: a Transparent BSDF (the camera ray passes every
+    surface) and AOV outputs written at the surface `Light Path > Transparent Depth` = j:
+      hit<j>: its planar depth (Camera Data > View Z Depth), negated on a back face, 0 where that
+        surface is not solid (its alpha, the group's input, is below `threshold`: a hole);
+      stop: the sum of 2^j over the solid surfaces of holdout objects (the ray ends there);
+      open: the sum of 2^j over the solid surfaces that are open (a card, a sheet): the
+        Ambient Occlusion node traced inside the surface against its own object only escapes
+        (a closed mesh always meets its other side);
+      normal: the sum of the solid surfaces' world normals, each weighted by 0.001^j, so that
+        the first solid surface's dominates (1e-3 relative at most).
+    Made again when made for other slots or another threshold."""
+    slots = _slots(hits)
+    group = bpy.data.node_groups.get(GROUP_NAME)
+    if group is not None and group.get("ssao_slots") == slots and \
+            group.get("ssao_threshold") == threshold:
+        return group
+    if group is None:
+        group = bpy.data.node_groups.new(GROUP_NAME, "ShaderNodeTree")
+        compat.new_socket(group, 'INPUT', 'NodeSocketFloat', "Alpha")
+        compat.new_socket(group, 'OUTPUT', 'NodeSocketShader', "Shader")
+    group["ssao_slots"], group["ssao_threshold"] = slots, threshold
+    nodes, links = group.nodes, group.links
     nodes.clear()
-    output = nodes.new("ShaderNodeOutputMaterial")
-    links.new(nodes.new("ShaderNodeBsdfTransparent").outputs[0], output.inputs["Surface"])
+    inputs, outputs = nodes.new("NodeGroupInput"), nodes.new("NodeGroupOutput")
+    links.new(nodes.new("ShaderNodeBsdfTransparent").outputs[0], outputs.inputs[0])
     light_path = nodes.new("ShaderNodeLightPath")
     geometry = nodes.new("ShaderNodeNewGeometry")
     camera = nodes.new("ShaderNodeCameraData")
+    depth = light_path.outputs["Transparent Depth"]
+
+    def math(operation, a, b=None, c=None):
+        node = nodes.new("ShaderNodeMath")
+        node.operation = operation
+        for socket, value in zip(node.inputs, (a, b, c)):
+            if isinstance(value, (int, float)):
+                socket.default_value = value
+            elif value is not None:
+                links.new(value, socket)
+        return node.outputs[0]
 
     def aov(name, socket):
         node = nodes.new("ShaderNodeOutputAOV")
         compat.set_aov_output_name(node, name)
         links.new(socket, node.inputs["Color" if name == "normal" else "Value"])
 
-    for k in range(1, hits + 1):
-        # 1 at hit k, 0 elsewhere: Transparent Depth counts the surfaces passed (integers).
-        at_hit = nodes.new("ShaderNodeMath")
-        at_hit.operation = 'COMPARE'
-        at_hit.inputs[1].default_value = k - 1
-        at_hit.inputs[2].default_value = 0.5
-        links.new(light_path.outputs["Transparent Depth"], at_hit.inputs[0])
-        values = [("depth", camera.outputs["View Z Depth"])]
-        if k >= 2:
-            values.append(("facing", geometry.outputs["Backfacing"]))
-        for name, source in values:
-            product = nodes.new("ShaderNodeMath")
-            product.operation = 'MULTIPLY'
-            links.new(at_hit.outputs[0], product.inputs[0])
-            links.new(source, product.inputs[1])
-            aov(f"{name}{k}", product.outputs[0])
-        if k == 1:
-            scaled = nodes.new("ShaderNodeVectorMath")
-            scaled.operation = 'SCALE'
-            links.new(geometry.outputs["Normal"], scaled.inputs[0])
-            links.new(at_hit.outputs[0], scaled.inputs["Scale"])
-            aov("normal", scaled.outputs[0])
+    # Cycles counts a surface as solid where its alpha >= the threshold.
+    solid = math('GREATER_THAN', inputs.outputs["Alpha"], threshold - 1e-6) if threshold > 0 \
+        else 1.0
+    # A solid holdout ends the beauty's ray with no Depth (measured): `stop` marks it
+    # (_Holdouts), and it is no surface.
+    holdout = nodes.new("ShaderNodeAttribute")
+    holdout.attribute_type, holdout.attribute_name = 'OBJECT', HOLDOUT_PROPERTY
+    aov("stop", math('MULTIPLY', math('MULTIPLY', holdout.outputs["Fac"], solid),
+                     math('POWER', 2.0, depth)))
+    solid = math('MULTIPLY', solid, math('SUBTRACT', 1.0, holdout.outputs["Fac"]))
+    sign = math('MULTIPLY_ADD', geometry.outputs["Backfacing"], -2.0, 1.0)  # -1 on a back face
+    signed_depth = math('MULTIPLY', math('MULTIPLY', camera.outputs["View Z Depth"], sign),
+                        solid)
+    for j in range(slots):
+        aov(f"hit{j}", math('MULTIPLY', math('COMPARE', depth, float(j), 0.5), signed_depth))
+    # Inside = behind the surface as modelled: Geometry > Normal faces the ray, so it is turned
+    # back on a back face.
+    outward = nodes.new("ShaderNodeVectorMath")
+    outward.operation = 'SCALE'
+    links.new(geometry.outputs["Normal"], outward.inputs[0])
+    links.new(sign, outward.inputs["Scale"])
+    inside = nodes.new("ShaderNodeAmbientOcclusion")
+    inside.inside, inside.only_local, inside.samples = True, True, OPEN_SAMPLES
+    inside.inputs["Distance"].default_value = OPEN_DISTANCE
+    links.new(outward.outputs[0], inside.inputs["Normal"])
+    is_open = math('GREATER_THAN', inside.outputs["AO"], 0.5)
+    aov("open", math('MULTIPLY', math('MULTIPLY', is_open, solid), math('POWER', 2.0, depth)))
+    weighted = nodes.new("ShaderNodeVectorMath")
+    weighted.operation = 'SCALE'
+    links.new(geometry.outputs["Normal"], weighted.inputs[0])
+    links.new(math('MULTIPLY', math('POWER', 0.001, depth), solid), weighted.inputs["Scale"])
+    aov("normal", weighted.outputs[0])
+    return group
+
+
+def _override_material(group):
+    """The view layer's material override where no material needs its own (every surface
+    solid): the hits group on every surface."""
+    material = bpy.data.materials.get(MATERIAL_NAME) or bpy.data.materials.new(MATERIAL_NAME)
+    material.use_nodes = True
+    nodes, links = material.node_tree.nodes, material.node_tree.links
+    if not any(n.bl_idname == "ShaderNodeGroup" and n.node_tree == group for n in nodes):
+        nodes.clear()
+        node = nodes.new("ShaderNodeGroup")
+        node.node_tree = group
+        node.inputs["Alpha"].default_value = 1.0
+        links.new(node.outputs[0], nodes.new("ShaderNodeOutputMaterial").inputs["Surface"])
     return material
+
+
+# Each material's alpha, as Cycles' camera rays see it (transparency = the weight of its
+# Transparent BSDF closures): an expression over the material's own sockets, folded where
+# constant. A term is a float, an output socket, or (operation, term, term).
+def _transparency(socket, seen=0):
+    """Transparency of the shader output `socket` (None: an unlinked shader input: none)."""
+    if socket is None or seen > 32:
+        return 0.0
+    node = socket.node
+    kind = node.bl_idname
+    if kind == "NodeReroute":
+        return _transparency(_linked(node.inputs[0]), seen + 1)
+    if kind == "ShaderNodeBsdfTransparent":
+        color = node.inputs["Color"]
+        return 1.0 if color.is_linked else sum(color.default_value[:3]) / 3.0
+    if kind == "ShaderNodeMixShader":
+        fac = _value(node.inputs[0])
+        first = _transparency(_linked(node.inputs[1]), seen + 1)
+        second = _transparency(_linked(node.inputs[2]), seen + 1)
+        return _op('ADD', first, _op('MULTIPLY', fac, _op('SUBTRACT', second, first)))
+    if kind == "ShaderNodeAddShader":
+        return _op('ADD', _transparency(_linked(node.inputs[0]), seen + 1),
+                   _transparency(_linked(node.inputs[1]), seen + 1))
+    if kind == "ShaderNodeBsdfPrincipled" and "Alpha" in node.inputs:
+        return _op('SUBTRACT', 1.0, _value(node.inputs["Alpha"]))
+    return 0.0  # any other shader (and a group's: not looked into) is opaque
+
+
+def _linked(socket):
+    return socket.links[0].from_socket if socket.is_linked and socket.links else None
+
+
+def _value(socket):
+    source = _linked(socket)
+    if source is not None:
+        return source
+    value = socket.default_value
+    return float(value) if isinstance(value, (int, float)) else float(sum(value[:3]) / 3.0)
+
+
+def _op(operation, a, b):
+    if isinstance(a, float) and isinstance(b, float):
+        return {'ADD': a + b, 'SUBTRACT': a - b, 'MULTIPLY': a * b}[operation]
+    if operation == 'MULTIPLY' and (a == 0.0 or b == 0.0):
+        return 0.0
+    if operation == 'ADD' and (a == 0.0 or b == 0.0):
+        return b if a == 0.0 else a
+    return (operation, a, b)
+
+
+def _alpha(material):
+    """(alpha term, Cycles output node) of a node material, or None where it has none."""
+    if not material.use_nodes or material.node_tree is None:
+        return None
+    output = material.node_tree.get_output_node('CYCLES')
+    if output is None:
+        return None
+    transparency = _transparency(_linked(output.inputs["Surface"]))
+    return _op('SUBTRACT', 1.0, transparency), output
+
+
+def _needs_own(material):
+    """Whether the helper must run `material`'s own tree: a surface alpha that is not 1
+    everywhere, or displacement that moves the surface."""
+    found = _alpha(material)
+    if found is None:
+        return False
+    alpha, output = found
+    moved = output.inputs["Displacement"].is_linked and \
+        compat.displacement_method(material) != 'BUMP'
+    return moved or not (isinstance(alpha, float) and alpha >= 1.0)
+
+
+class _Holdouts:
+    """While open, the objects that are holdouts in the user's view layer (their own setting
+    or their collection's) carry HOLDOUT_PROPERTY = 1, which the hits group reads (an
+    Attribute node of type Object): the helper's surfaces are transparent, so Cycles' holdout
+    does not end its rays as it ends the beauty's. Closing removes the property."""
+
+    def __init__(self, scene):
+        self.scene = scene
+        self.marked = []
+
+    def __enter__(self):
+        layer = _view_layer(self.scene)
+        for obj in self.scene.objects:
+            if obj.library is None and obj.holdout_get(view_layer=layer):
+                obj[HOLDOUT_PROPERTY] = 1.0
+                self.marked.append(obj)
+        return self
+
+    def __exit__(self, *exc):
+        for obj in self.marked:
+            if HOLDOUT_PROPERTY in obj:
+                del obj[HOLDOUT_PROPERTY]
+        self.marked.clear()
+        return False
+
+
+class _MaterialOutputs:
+    """While open, every editable node material the scene may show has, beside its own nodes, a
+    Material Output for Cycles (made the active one) running the hits group with the material's
+    own alpha and its own displacement; closing removes what was added and makes the outputs
+    active again as they were. The user's materials are otherwise untouched (docs/blender.md)."""
+
+    def __init__(self, group):
+        self.group = group
+        self.added = []  # (material, nodes added, {output node name: was active})
+
+    def __enter__(self):
+        try:
+            for material in bpy.data.materials:
+                if material.library is None and material.name != MATERIAL_NAME:
+                    self._add(material)
+        except BaseException:
+            self.__exit__(None, None, None)
+            raise
+        return self
+
+    def _add(self, material):
+        found = _alpha(material)
+        if found is None:
+            return
+        alpha, output = found
+        tree = material.node_tree
+        outputs = [n for n in tree.nodes if n.bl_idname == "ShaderNodeOutputMaterial"]
+        entry = (material, [], {n.name: n.is_active_output for n in outputs})
+        self.added.append(entry)
+        made = entry[1]
+
+        def build(term):
+            if isinstance(term, float) or not isinstance(term, tuple):
+                return term
+            node = tree.nodes.new("ShaderNodeMath")
+            made.append(node)
+            node.operation = term[0]
+            for socket, part in zip(node.inputs, term[1:]):
+                part = build(part)
+                if isinstance(part, float):
+                    socket.default_value = part
+                else:
+                    tree.links.new(part, socket)
+            return node.outputs[0]
+
+        hits = tree.nodes.new("ShaderNodeGroup")
+        made.append(hits)
+        hits.node_tree = self.group
+        alpha = build(alpha)
+        if isinstance(alpha, float):
+            hits.inputs["Alpha"].default_value = alpha
+        else:
+            tree.links.new(alpha, hits.inputs["Alpha"])
+        ours = tree.nodes.new("ShaderNodeOutputMaterial")
+        made.append(ours)
+        ours.target = 'CYCLES'
+        tree.links.new(hits.outputs[0], ours.inputs["Surface"])
+        displacement = _linked(output.inputs["Displacement"])
+        if displacement is not None:
+            tree.links.new(displacement, ours.inputs["Displacement"])
+        ours.is_active_output = True
+
+    def __exit__(self, *exc):
+        for material, made, active in reversed(self.added):
+            tree = material.node_tree
+            for node in made:
+                tree.nodes.remove(node)
+            for name, was_active in active.items():
+                if was_active and name in tree.nodes:
+                    tree.nodes[name].is_active_output = True
+        self.added.clear()
+        return False
 
 
 def _sync_collections(helper, scene, camera):
@@ -191,9 +432,10 @@ def _view_layer(scene):
     return next((layer for layer in scene.view_layers if layer.use), scene.view_layers[0])
 
 
-def helper_scene(scene, hits, overscan):
+def helper_scene(scene, hits, overscan, own_materials):
     """The hidden scene that renders the layers of `scene` (made once, then brought up to date:
-    collections, camera, size, sampling)."""
+    collections, camera, size, sampling). `own_materials`: the surfaces run their materials'
+    own Cycles outputs (_MaterialOutputs) rather than the view layer's override."""
     name = HELPER_PREFIX + scene.name
     helper = bpy.data.scenes.get(name)
     if helper is None:
@@ -210,15 +452,19 @@ def helper_scene(scene, hits, overscan):
     layer.name = LAYER_NAME
     _copy_layer_flags(compat.layer_collection(_view_layer(scene)),
                       compat.layer_collection(layer))
-    layer.use_pass_z = layer.use_pass_normal = False
+    # With the materials' own outputs, a surface without one (no material, a linked or
+    # non-node material) stops the ray as in the beauty: its depth and normal are the passes'.
+    layer.use_pass_z = layer.use_pass_normal = own_materials
+    layer.pass_alpha_threshold = _alpha_threshold(scene)
     for aov in _aov_names(hits):
         if aov not in layer.aovs:
             item = layer.aovs.add()
             item.name = aov
             item.type = 'COLOR' if aov == "normal" else 'VALUE'
-    layer.material_override = _override_material(hits)
+    group = _hits_group(hits, _alpha_threshold(scene))
+    layer.material_override = None if own_materials else _override_material(group)
     _render_settings(scene, helper, hits, overscan)
-    return helper
+    return helper, group
 
 
 def _render_settings(scene, helper, hits, overscan):
@@ -239,8 +485,8 @@ def _render_settings(scene, helper, hits, overscan):
     cycles.samples = 1  # each pixel's AOVs come from its one camera ray
     cycles.use_adaptive_sampling = False
     cycles.use_denoising = False
-    # Passing hit k takes k transparent bounces.
-    cycles.transparent_max_bounces = hits
+    # Passing the surface at transparent depth j takes j + 1 transparent bounces.
+    cycles.transparent_max_bounces = _slots(hits)
     cycles.max_bounces = 0
     # The same sample positions as a Cycles beauty's first sample (its Depth pass).
     for attribute in ("seed", "use_animated_seed", "filter_width", "pixel_filter_type",
@@ -264,31 +510,103 @@ def _render(helper, path):
     result.save_render(path, scene=helper)
 
 
-def _planes(path, hits):
-    """{aov name: (height, width[, channels]) float32 array, row 0 on top} of the saved file."""
+def _planes(path, hits, own_materials):
+    """{aov or pass name: (height, width[, channels]) float32 array, row 0 on top} of the saved
+    file."""
     planes, _ = multilayer.read(path)
+    names = _aov_names(hits) + (["Depth", "Normal"] if own_materials else [])
     layers = {}
-    for aov in _aov_names(hits):
+    for aov in names:
         prefix = f"{LAYER_NAME}.{aov}."
         channels = sorted((name for name in planes if name.startswith(prefix)),
                           key=lambda name: "XYZWRGBA".find(name[-1]))
         if not channels:
             raise RuntimeError(f"the hidden-surface render has no '{aov}' pass "
                                f"(channels: {', '.join(sorted(planes))})")
-        if aov == "normal":
+        if aov in ("normal", "Normal"):
             layers[aov] = np.stack([planes[c] for c in channels[:3]], axis=-1)
         else:
             layers[aov] = planes[channels[0]]
     return layers
 
 
+def surfaces(raw, hits, own_materials):
+    """The surfaces along each pixel's ray from the helper's planes, in order: (depth, facing)
+    arrays of shape (hits, height, width), BACKGROUND / 0 past the last, and the first
+    surface's normal (height, width, 3).
+
+    Holes (alpha below the threshold) are not surfaces, and the ray ends at a holdout (the
+    stop AOV). A solid surface is a front face (facing 0) or a back face (1), as met. An open
+    one (a card, a sheet: the open AOV) with another surface behind it is handed on as a front
+    face and a back face at the same depth, whichever way it faces: a solid of no thickness,
+    so that the space between it and what lies behind reads as free (docs/conventions.md).
+    An open surface that is the ray's last known one is a front face: what lies behind it
+    (the far side of a floor or a wall) is reached only through it, which the library's
+    thickness rule stands for. A surface that stopped the ray (own_materials: the Depth pass
+    beyond the AOVs' hits) is a front face. At most `hits` entries, twins included (a twin
+    takes the place of a farther surface: with 5 entries rather than 3 the cut-out scene's
+    AO was no closer to Cycles', docs/blender.md)."""
+    signed = np.stack([raw[f"hit{j}"] for j in range(_slots(hits))])
+    open_bits = np.rint(raw["open"]).astype(np.int64)
+    is_open = np.stack([(open_bits >> j) & 1 for j in range(_slots(hits))]).astype(bool)
+    found = signed != 0
+    # The ray ends at its first holdout: nothing from there on is seen.
+    stop_bits = np.rint(raw["stop"]).astype(np.int64)
+    stopped_at = np.stack([(stop_bits >> j) & 1 for j in range(_slots(hits))]).astype(bool)
+    ended = np.logical_or.accumulate(stopped_at, axis=0)
+    found &= ~ended
+    depth = np.abs(signed)
+    # Something behind each slot: a later slot's surface, or the surface that stopped the ray.
+    later = np.zeros_like(found)
+    later[:-1] = np.flip(np.logical_or.accumulate(np.flip(found[1:], 0), axis=0), 0)
+    if own_materials:
+        stop = np.where(ended[-1], 0, raw["Depth"])
+        later |= ((stop > 0) & (stop < BACKGROUND * 0.5))[None]
+    back = (signed < 0) & ~is_open  # an open surface is never read as leaving a solid
+    is_open &= later
+    # Each slot: its surface, then its card twin (a back face at the same depth).
+    parts_depth = [depth, depth]
+    parts_facing = [back.astype(np.float32), np.ones_like(depth)]
+    parts_found = [found, found & is_open]
+    normal = raw["normal"]
+    if own_materials:
+        stop = stop[None]
+        stopped = (stop > 0) & (stop < BACKGROUND * 0.5)
+        parts_depth.append(stop)
+        parts_facing.append(np.zeros_like(stop))
+        parts_found.append(stopped)
+        no_aov_normal = ~found.any(axis=0)
+        normal = np.where(no_aov_normal[..., None], raw["Normal"], normal)
+    # Interleave slot by slot (surface, twin), keeping ray order; then the ray's stop.
+    order_depth = np.stack(parts_depth[:2], axis=1).reshape(-1, *depth.shape[1:])
+    order_facing = np.stack(parts_facing[:2], axis=1).reshape(-1, *depth.shape[1:])
+    order_found = np.stack(parts_found[:2], axis=1).reshape(-1, *depth.shape[1:])
+    if own_materials:
+        order_depth = np.concatenate([order_depth, parts_depth[2]])
+        order_facing = np.concatenate([order_facing, parts_facing[2]])
+        order_found = np.concatenate([order_found, parts_found[2]])
+    first = np.argsort(~order_found, axis=0, kind="stable")[:hits]
+    kept = np.take_along_axis(order_found, first, axis=0)
+    out_depth = np.where(kept, np.take_along_axis(order_depth, first, axis=0),
+                         np.float32(BACKGROUND)).astype(np.float32)
+    out_facing = np.where(kept, np.take_along_axis(order_facing, first, axis=0),
+                          0).astype(np.float32)
+    length = np.linalg.norm(normal, axis=-1, keepdims=True)
+    normal = np.where(length > 0, normal / np.maximum(length, 1e-30), 0).astype(np.float32)
+    return out_depth, out_facing, normal
+
+
 def render_layers(scene, hits=MAX_HITS, overscan=0, folder=None):
     """Renders `scene`'s hidden-surface layers at its current frame (set it first with
     scene.frame_set: the camera is read as it is). Returns {name: float32 array, row 0 on top},
     of the render's size + 2 * overscan on each axis:
-      "depth": hit 1's planar depth (BACKGROUND where the ray hits nothing), "normal": its
-      world-space normal (height, width, 3), and for k = 2..hits "depth<k>" (BACKGROUND where
-      there is no k-th hit) and "facing<k>" (1 = back face, 0 = front face or no hit).
+      "depth": the 1st surface's planar depth (BACKGROUND where the ray meets none), "normal":
+      its world-space normal (height, width, 3), and for k = 2..hits "depth<k>" (BACKGROUND
+      where there is no k-th entry) and "facing<k>" (1 = back face, 0 = front face or none):
+      the surfaces behind it, an open surface as two entries (surfaces()).
+    Surfaces are as Cycles' camera rays see them: alpha below the view layer's threshold is a
+    hole, material displacement is applied (both where some material needs it: its own
+    outputs are run, _MaterialOutputs).
     The result is kept for the scene and frame until forget(): a recompute does not render."""
     if not 1 <= hits <= MAX_HITS:
         raise ValueError(f"hits must be 1 to {MAX_HITS}, not {hits}")
@@ -300,25 +618,29 @@ def render_layers(scene, hits=MAX_HITS, overscan=0, folder=None):
     cached = _cache.setdefault(scene.name, {})
     if key in cached:
         return cached[key]
-    helper = helper_scene(scene, hits, overscan)
+    own_materials = any(_needs_own(m) for m in bpy.data.materials
+                        if m.library is None and m.name != MATERIAL_NAME)
+    helper, group = helper_scene(scene, hits, overscan, own_materials)
     folder = folder or bpy.app.tempdir
     os.makedirs(folder, exist_ok=True)
     path = os.path.join(folder, f"layers_{bpy.path.clean_name(scene.name)}_"
                                 f"{scene.frame_current:04d}.exr")
     try:
-        _render(helper, path)
-        raw = _planes(path, hits)
+        with _Holdouts(scene):
+            if own_materials:
+                with _MaterialOutputs(group):
+                    _render(helper, path)
+            else:
+                _render(helper, path)
+        raw = _planes(path, hits, own_materials)
     finally:
         if os.path.exists(path):
             os.remove(path)
-    layers = {"normal": raw["normal"]}
-    for k in range(1, hits + 1):
-        depth = raw[f"depth{k}"]
-        hit = depth > 0  # a hit's View Z Depth is positive; no hit leaves the AOV at 0
-        name = "depth" if k == 1 else f"depth{k}"
-        layers[name] = np.where(hit, depth, np.float32(BACKGROUND)).astype(np.float32)
-        if k >= 2:
-            layers[f"facing{k}"] = np.where(hit, raw[f"facing{k}"], 0).astype(np.float32)
+    depth, facing, normal = surfaces(raw, hits, own_materials)
+    layers = {"depth": depth[0], "normal": normal}
+    for k in range(2, hits + 1):
+        layers[f"depth{k}"] = depth[k - 1]
+        layers[f"facing{k}"] = facing[k - 1]
     while len(cached) >= CACHED_PER_SCENE:  # an animation's frames must not pile up
         cached.pop(next(iter(cached)))
     cached[key] = layers
@@ -337,3 +659,6 @@ def remove_helpers():
     material = bpy.data.materials.get(MATERIAL_NAME)
     if material is not None:
         bpy.data.materials.remove(material)
+    group = bpy.data.node_groups.get(GROUP_NAME)
+    if group is not None:
+        bpy.data.node_groups.remove(group)

@@ -365,12 +365,54 @@ class AddonTest(unittest.TestCase):
         self.assertLess(rmse["PEELED", 16], rmse["NONE", 0] - 0.03)
         self.assertLess(rmse["PEELED", 16], min(rmse["PEELED", 0], rmse["NONE", 16]))
 
+    def test_hidden_surfaces_read_cutouts_and_cards(self):
+        # Open surfaces with alpha cut-outs (a lattice fence, leaf cards facing either way, a
+        # curtain; make_reference_scene.build_cutouts): the helper sees the holes as the beauty
+        # does and hands a card with something behind it on as a solid of no thickness. The
+        # node's defaults must beat one layer without band by 15 %, and the layers alone must
+        # not be worse than one layer. Measured at 160x90, 128 spp (3.4, 4.3, 5.2 alike): one
+        # layer 0.1142, layers 0.0795 (before: 0.1227), defaults 0.0557 (before: 0.1090).
+        rmse = {}
+        for name, options in (("one", ONE_LAYER), ("layers", ("--hidden-surfaces", "PEELED",
+                                                              "--overscan", "0")),
+                              ("defaults", ())):
+            _, ao, passes = self.render_scene(f"cutouts_{name}", "--cutouts", "--samples",
+                                              "128", "--ao-pass", *options)
+            depth = passes["Depth.V"]
+            geometry = np.isfinite(depth) & (depth < 1e9)
+            rmse[name] = float(np.sqrt(np.mean((ao[geometry] - passes["AO.R"][geometry]) ** 2)))
+            print(f"\n[measure] cut-outs and cards, node AO vs Cycles AO pass, {name}: RMSE "
+                  f"{rmse[name]:.4f}", file=sys.stderr)
+        self.assertLess(rmse["defaults"], 0.85 * rmse["one"])
+        self.assertLess(rmse["layers"], rmse["one"])
+
+    def test_helper_sees_what_the_render_shows(self):
+        # Alpha cut-outs under each blend method, material displacement, a holdout object and
+        # a holdout collection, an object hidden from the camera: the helper's first surface
+        # must be the beauty's Depth pass (inside the frame) and a wider render's (in the band)
+        # on 99.9 % of the pixels. Measured at 320x180: 99.94 % inside (35 pixels where a
+        # holdout box's base is coplanar with the floor), 100 % in a 16 px band.
+        result = os.path.join(self.folder("features"), "first_hits.json")
+        blend = self.blender.build_scene("features/scene", "--render-features")
+        log = self.blender.run(blend, "--python-exit-code", "1", "-P",
+                               os.path.join(HERE, "check_first_hits.py"), "--", "--out", result,
+                               "--overscan", "16")
+        print("\n" + "\n".join(line for line in log.splitlines() if "[measure]" in line),
+              file=sys.stderr)
+        with open(result) as f:
+            agreement = json.load(f)
+        self.assertGreaterEqual(agreement["inside"], 0.999, agreement)
+        self.assertGreaterEqual(agreement["band"], 0.999, agreement)
+
     def test_hidden_surfaces_leave_the_scene_unchanged(self):
         # The helper render must not change the user's scene, view layers, camera or saved
         # file; its hidden scene, camera and material stay out of the file.
         folder = self.folder("unchanged")
+        # With cut-outs and holdouts, so that the helper runs the materials' own outputs and
+        # marks the holdout objects while it renders (hidden_surfaces.py): both undone after.
         blend = self.blender.build_scene("unchanged/scene", "--hidden-surfaces", "PEELED",
                                          "--overscan", "8", "--camera", "ortho",
+                                         "--render-features",
                                          "--output", os.path.join(folder, "out_####.png"))
         saved = os.path.join(folder, "saved.blend")
         state = os.path.join(folder, "state_{}.json")
@@ -384,6 +426,12 @@ class AddonTest(unittest.TestCase):
             "               'objects': sorted(o.name for o in s.objects),\n"
             "               'cameras': sorted(x.name for x in bpy.data.cameras),\n"
             "               'materials': sorted(x.name for x in bpy.data.materials),\n"
+            "               'trees': {m.name: [sorted(n.name for n in m.node_tree.nodes), "
+            "sorted((l.from_node.name, l.from_socket.identifier, l.to_node.name, "
+            "l.to_socket.identifier) for l in m.node_tree.links), sorted(n.name for n in "
+            "m.node_tree.nodes if getattr(n, 'is_active_output', False))] "
+            "for m in bpy.data.materials if m.node_tree and not m.name.startswith('.SSAO')},\n"
+            "               'properties': {o.name: sorted(o.keys()) for o in s.objects},\n"
             "               'camera': [c.name] + [getattr(c.data, k) for k in keys] + "
             "[list(map(list, c.matrix_world))],\n"
             "               'layers': [(l.name, l.use, l.use_pass_z, l.use_pass_normal, "
@@ -407,7 +455,7 @@ class AddonTest(unittest.TestCase):
             saved_state = json.load(f)
         helpers = [name for name in after["scenes"] if name.startswith(".SSAO layers")]
         self.assertEqual(len(helpers), 1, after["scenes"])  # the render did use the helper
-        for key in ("objects", "camera", "layers", "render"):
+        for key in ("objects", "camera", "layers", "render", "trees", "properties"):
             self.assertEqual(after[key], before[key], key)
             self.assertEqual(saved_state[key], before[key], key)
         for key in ("scenes", "cameras", "materials"):
@@ -442,7 +490,8 @@ class AddonTest(unittest.TestCase):
         depth, depth2 = channels[f"{layer}.Depth.Z"], channels[f"{layer}.Depth2.Z"]
         hit = depth2 < 1e9
         self.assertGreater(int(hit.sum()), 100, "some pixels have a 2nd hit")
-        self.assertTrue(np.all(depth2[hit] > depth[hit]), "the 2nd hit lies behind the 1st")
+        # (at the same depth where the 1st is a card: its back face, "Open surfaces")
+        self.assertTrue(np.all(depth2[hit] >= depth[hit]), "the 2nd hit lies behind the 1st")
         self.assertTrue(set(np.unique(channels[f"{layer}.Facing2.V"])) <= {0.0, 1.0})
         with open(camera) as f:
             self.assertEqual(json.load(f)["type"], "PERSP")
