@@ -23,6 +23,7 @@ import os
 import bpy
 import numpy as np
 
+from . import camera as camera_module
 from . import compat, multilayer
 
 HELPER_PREFIX = ".SSAO layers "
@@ -391,40 +392,19 @@ def _camera_copy(scene, helper, overscan):
                       "shift_y", "ortho_scale", "clip_start", "clip_end"):
         setattr(data, attribute, getattr(settings, attribute))
     data.dof.use_dof = False  # the depth of the pixel's centre ray, not of a lens sample
+    # The rendered image (the crop of a render cropped to its border) widened by the band, as a
+    # frame of its own on the same pixel grid.
+    framed = camera_module.cropped(
+        {name: getattr(settings, name) for name in camera_module.CROPPED}, scene.render, overscan)
+    for name, value in framed.items():
+        setattr(data, name, value)
     obj.matrix_world = source.matrix_world.copy()
-    if overscan:
-        _widen(data, scene.render, overscan)
     return obj
 
 
-def _widen(data, render, overscan):
-    """Widens the camera by `overscan` pixels on every side, on the same pixel grid. The frame's
-    fitted side (sensor_fit; AUTO: the larger side, aspect included) spans sensor size or
-    ortho_scale over its pixels: that grows by (L + 2G) / L. Shift is a fraction of that side,
-    so it shrinks by the same factor to stay the same distance."""
-    width, height = render_size(render)
-    aspect_x, aspect_y = render.pixel_aspect_x, render.pixel_aspect_y
-    fit = data.sensor_fit
-    if fit == 'AUTO':
-        fit = 'HORIZONTAL' if width * aspect_x >= height * aspect_y else 'VERTICAL'
-        size = data.sensor_width  # AUTO fits sensor_width to the larger side
-        data.sensor_fit = fit
-        if fit == 'VERTICAL':
-            data.sensor_height = size
-    pixels = width if fit == 'HORIZONTAL' else height
-    factor = (pixels + 2 * overscan) / pixels
-    if fit == 'HORIZONTAL':
-        data.sensor_width *= factor
-    else:
-        data.sensor_height *= factor
-    data.ortho_scale *= factor
-    data.shift_x /= factor
-    data.shift_y /= factor
-
-
 def render_size(render):
-    scale = render.resolution_percentage / 100.0
-    return int(render.resolution_x * scale), int(render.resolution_y * scale)
+    """The rendered image's size (the crop's when the render is cropped to its border)."""
+    return camera_module.crop_window(render)[2:]
 
 
 def _view_layer(scene):

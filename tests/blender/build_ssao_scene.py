@@ -6,6 +6,7 @@ Ambient Occlusion (SSAO) node in the compositor and saves it as a .blend.
         -P tests/blender/build_ssao_scene.py -- --out scene.blend [--engine cycles|eevee]
         [--camera persp|ortho] [--width 160 --height 90 --samples 16] [--frames 1]
         [--output //render_####.png] [--ao-pass] [--radius 0.8] [--cutouts | --render-features]
+        [--border MIN_X MAX_X MIN_Y MAX_Y]
 
 The compositor: Render Layers (Image, Depth, Normal) -> SSAO -> Composite (Group Output in 5.x);
 the SSAO node's AO output also goes to a Viewer. With --frames N the camera moves and turns
@@ -51,6 +52,9 @@ def parse_args():
                         help="--cutouts, and material displacement, holdouts (an object, a "
                              "collection) and an object hidden from the camera "
                              "(make_reference_scene.build_render_features)")
+    parser.add_argument("--border", type=float, nargs=4, default=None,
+                        metavar=("MIN_X", "MAX_X", "MIN_Y", "MAX_Y"),
+                        help="render only this border (fractions of the frame), cropped to it")
     parser.add_argument("--passes-dir", default=None,
                         help="also write Image, Depth, Normal (and AO) of every frame to "
                              "DIR/####.exr with a top-level File Output node")
@@ -83,6 +87,10 @@ def main():
     render = scene.render
     render.resolution_x, render.resolution_y = args.width, args.height
     render.resolution_percentage = 100
+    if args.border:
+        render.use_border = render.use_crop_to_border = True
+        (render.border_min_x, render.border_max_x, render.border_min_y,
+         render.border_max_y) = args.border
     if args.engine == "cycles":
         render.engine = 'CYCLES'
         scene.cycles.device = 'CPU'

@@ -56,6 +56,7 @@ def main():
     hidden_surfaces = addon_module("hidden_surfaces")
     multilayer = addon_module("multilayer")
     compat = addon_module("compat")
+    camera = addon_module("camera")
     scene = bpy.context.scene
     scene.frame_set(scene.frame_start)
     scene.render.use_compositing = False  # the user's passes only, no node
@@ -69,9 +70,13 @@ def main():
     inner = agree(helper[band:band + height, band:band + width], inside,
                   hidden_surfaces.BACKGROUND)
     # The same scene rendered wider by the band, as the helper widens its own camera.
-    hidden_surfaces._widen(scene.camera.data, scene.render, band)
+    data = scene.camera.data
+    for name, value in camera.cropped({name: getattr(data, name) for name in camera.CROPPED},
+                                      scene.render, band).items():
+        setattr(data, name, value)
     scene.render.resolution_x, scene.render.resolution_y = width + 2 * band, height + 2 * band
     scene.render.resolution_percentage = 100
+    scene.render.use_border = False
     wide = user_depth(scene, folder, multilayer, compat)
     whole = agree(helper, wide, hidden_surfaces.BACKGROUND)
     in_band = np.ones(whole.shape, bool)
