@@ -264,6 +264,102 @@ TEST(Layers, FacingTellsAnOpenSurfaceFromASolid) {
   EXPECT_LT(alternating.mean, one.mean - 0.02);
 }
 
+TEST(Layers, ACardIsReadTheSameFromEitherSideWhenHandedOnAsATwin) {
+  // A card (a single plane: leaves, a fence, paper) 1 in front of a wall, and a post in front
+  // of the card. Behind the post the card is the ray's 3rd surface; rendered without knowing it
+  // is open, it is a front face or a back face depending on which way its normal points, and a
+  // back face reads as leaving a solid entered at the post: the gap between them a solid. The
+  // Blender add-on's helper knows a card from a closed mesh and hands it on as a front face and
+  // a back face at its depth (docs/conventions.md, "Open surfaces"): a solid of no thickness,
+  // the same whichever way it faces.
+  Camera cam;
+  cam.width = 128, cam.height = 96;
+  const Solid wall = {{{0, 0, -6}, {0, 0, 1}}};
+  const Solid card = box({-0.6, -10, -5.001}, {0.6, 10, -5.0});  // 1 mm, for the rays
+  const Solid post = box({-0.15, -10, -4.3}, {0.15, 10, -4.0});
+  const std::vector<Solid> solids = {wall, card, post};
+  Scene s = ray_cast(cam, solids);
+  enum class Card { kTwin, kFront, kBack };
+  const auto ao_with = [&](Card reading) {
+    constexpr int kLayers = 4;
+    const size_t n = s.depth.size();
+    std::vector<std::vector<float>> depth(kLayers, std::vector<float>(n, INFINITY));
+    std::vector<std::vector<float>> facing(kLayers, std::vector<float>(n, 0.0f));
+    for (int y = 0; y < cam.height; ++y) {
+      for (int x = 0; x < cam.width; ++x) {
+        V3 o, d;
+        cam.ray(x, y, o, d);
+        std::vector<std::pair<double, float>> hits;  // (t, facing)
+        for (const Solid* solid : {&wall, &post}) {
+          double t = 0;
+          V3 unused{0, 0, 0};
+          if (!enter_solid(*solid, o, d, t, unused)) continue;
+          hits.push_back({t, 0.0f});
+          const double t_exit = exit_solid(*solid, o, d);
+          if (std::isfinite(t_exit)) hits.push_back({t_exit, 1.0f});
+        }
+        double t = 0;
+        V3 unused{0, 0, 0};
+        if (enter_solid(card, o, d, t, unused)) {
+          if (reading == Card::kTwin) {
+            hits.push_back({t, 0.0f});
+            hits.push_back({t * (1 + 1e-9), 1.0f});
+          } else {
+            hits.push_back({t, reading == Card::kBack ? 1.0f : 0.0f});
+          }
+        }
+        std::sort(hits.begin(), hits.end());
+        const size_t i = size_t(y) * cam.width + x;
+        for (size_t k = 1; k < hits.size() && k <= kLayers; ++k) {
+          depth[k - 1][i] = float(-(o + d * hits[k].first).z);
+          facing[k - 1][i] = hits[k].second;
+        }
+      }
+    }
+    return compute_ao(s, cam, kRadius, "hemisphere", true, [&](Job& j) {
+      j.set("resolution", "full");
+      for (int k = 0; k < kLayers; ++k) {
+        const std::string number = std::to_string(k + 2);
+        j.image(("depth" + number).c_str(), depth[k], s.width, s.height, 1);
+        j.image(("facing" + number).c_str(), facing[k], s.width, s.height, 1);
+      }
+    });
+  };
+  // The wall and the card within 0.7 of the post, away from the frame's top and bottom.
+  std::vector<size_t> pixels;
+  std::vector<double> reference;
+  for (int y = 6; y < cam.height - 6; y += 2) {
+    for (int x = 0; x < cam.width; ++x) {
+      const size_t i = size_t(y) * cam.width + x;
+      const V3 p = s.point[i];
+      if (!std::isfinite(s.depth[i]) || s.depth[i] < 4.9f || std::fabs(p.x) > 0.85 ||
+          std::fabs(p.x) < 0.16) {
+        continue;
+      }
+      pixels.push_back(i);
+      const V3 normal{s.normal[3 * i], s.normal[3 * i + 1], s.normal[3 * i + 2]};
+      reference.push_back(ray_traced_ao(solids, p, normal, kRadius, 512));
+    }
+  }
+  ASSERT_GT(pixels.size(), 300u);
+  const Error twin = error_against(ao_with(Card::kTwin), reference, pixels);
+  const Error front = error_against(ao_with(Card::kFront), reference, pixels);
+  const Error back = error_against(ao_with(Card::kBack), reference, pixels);
+  std::printf(
+      "[ measure  ] card behind a post, %d px of wall and card: handed on as a twin RMSE %.4f "
+      "bias %+.4f; one hit facing the camera RMSE %.4f bias %+.4f; facing away RMSE %.4f bias "
+      "%+.4f\n",
+      twin.count, twin.rmse, twin.bias, front.rmse, front.bias, back.rmse, back.bias);
+  // Read from its facing, either way the card is too dark around: the visible card is a solid
+  // of the assumed thickness reaching towards the wall (measured: bias -0.074 facing the
+  // camera, -0.069 facing away; behind the post the two readings differ).
+  EXPECT_LT(front.bias, -0.04);
+  EXPECT_LT(back.bias, -0.04);
+  // As a twin the gap between card and wall is free space: close to the ray-traced AO.
+  EXPECT_LT(twin.rmse, 0.5 * std::min(front.rmse, back.rmse));
+  EXPECT_LT(std::fabs(twin.bias), 0.02);
+}
+
 TEST(Layers, OverscanWithLayersEqualsTheWidenedFrameCropped) {
   constexpr int kBand = 16;
   Camera frame;
