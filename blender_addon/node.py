@@ -3,7 +3,7 @@
 whose properties are libssao's parameters, with the library's names, defaults and ranges."""
 import bpy
 
-from . import compat, compute, handlers, inner_tree, recomposite, ssao
+from . import compat, compute, handlers, inner_tree, recomposite, saved_form, ssao
 
 # Why the library's parameter table could not be read (shown on the node), or None.
 LIBRARY_ERROR = None
@@ -28,6 +28,15 @@ def _on_parameter_changed(node, context):
     # The node's own scene (the context's may be another one showing a pinned tree).
     handlers.parameter_changed(node, compute.scene_of_tree(node.id_data) or
                                (context.scene if context else None))
+
+
+def _on_overscan_changed(node, context):
+    # A band given in pixels (from the UI or a script: node.overscan = 16) is used as given;
+    # a saved file's settings put back (saved_form.py) keep their own overscan_mode.
+    if node.overscan_mode != 'PIXELS' and not saved_form.is_restoring():
+        node.overscan_mode = 'PIXELS'  # its own update recomputes
+        return
+    _on_parameter_changed(node, context)
 
 
 def _property_for(desc):
@@ -100,12 +109,23 @@ class CompositorNodeSSAO(bpy.types.CompositorNodeCustomGroup):
                ('PEELED', "Peeled", "The 2nd and 3rd surface hit along each pixel's ray, "
                                     "and whether each is a back face")],
         default=DEFAULT_HIDDEN_SURFACES, update=_on_parameter_changed)
+    # The band's width follows the radius unless given in pixels (setting `overscan` gives it;
+    # compute.band_width).
+    overscan_mode: bpy.props.EnumProperty(
+        name="Band",
+        description="How wide the guard band is",
+        items=[('RADIUS', "From radius",
+                "As wide as half the radius spans in pixels at the frame's edges (a helper "
+                "render; grows with the resolution)"),
+               ('PIXELS', "Pixels", "Overscan pixels per side (0: no band)")],
+        default='RADIUS', update=_on_parameter_changed)
     overscan: bpy.props.IntProperty(
         name="Overscan", subtype='PIXEL', min=0, max=4096, soft_max=256,
         default=DEFAULT_OVERSCAN,
         description="Guard band rendered around the frame, in pixels per side, so that "
-                    "occluders just outside the frame count (0: off; a helper render)",
-        update=_on_parameter_changed)
+                    "occluders just outside the frame count (0: off; a helper render). "
+                    "Setting it sets Band to Pixels",
+        update=_on_overscan_changed)
 
     def init(self, context):
         self.ssao_id = inner_tree.new_id()
@@ -159,9 +179,14 @@ class CompositorNodeSSAO(bpy.types.CompositorNodeCustomGroup):
         for name in FACE_PARAMETERS:
             if name in shown:
                 _draw_property(self, layout, name)
-        for name in compute.NODE_SETTINGS:
-            _draw_property(self, layout, name)
+        self._draw_settings(layout)
         self._draw_recompute_and_status(layout)
+
+    def _draw_settings(self, layout, stacked=False):
+        for name in compute.NODE_SETTINGS:
+            row = layout.row()
+            row.active = name != "overscan" or self.overscan_mode == 'PIXELS'
+            _draw_property(self, row, name, stacked)
 
     def draw_buttons_ext(self, context, layout):
         """The sidebar (N panel, Node tab, Properties): every property, a box per library
@@ -180,9 +205,7 @@ class CompositorNodeSSAO(bpy.types.CompositorNodeCustomGroup):
                     _draw_property(self, column, name, stacked=True)
         box = layout.box()
         box.label(text=SETTINGS_TITLE)
-        column = box.column()
-        for name in compute.NODE_SETTINGS:
-            _draw_property(self, column, name, stacked=True)
+        self._draw_settings(box.column(), stacked=True)
         self._draw_recompute_and_status(layout)
 
 

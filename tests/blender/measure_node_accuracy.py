@@ -25,7 +25,8 @@ def parse_args():
                         help="the EXR the scene's File Output node writes for frame 1")
     parser.add_argument("--settings", nargs="+",
                         default=["NONE:0", "PEELED:0", "NONE:64", "PEELED:64"],
-                        help="hidden_surfaces:overscan pairs")
+                        help="hidden_surfaces:overscan pairs (overscan: pixels, or 'radius' "
+                             "for the band that follows the radius)")
     parser.add_argument("--save", default=None,
                         help="also save each setting's AO and the reference as DIR/*.npy")
     return parser.parse_args(argv)
@@ -55,7 +56,12 @@ def main():
     node = ssao.compute.ssao_nodes(scene)[0]
     for setting in args.settings:
         hidden, overscan = setting.split(":")
-        node.hidden_surfaces, node.overscan = hidden, int(overscan)
+        node.hidden_surfaces = hidden
+        if overscan == "radius":
+            node.overscan_mode = 'RADIUS'
+        else:
+            node.overscan = int(overscan)  # sets overscan_mode to 'PIXELS'
+        band = ssao.compute.band_width(node, scene, depth) if overscan == "radius" else ""
         ao = ssao.compute.compute_ao(scene, node, render=False)
         if args.save:
             np.save(f"{args.save}/ao_{hidden}_{overscan}.npy", ao)
@@ -64,7 +70,8 @@ def main():
         rmse = {name: float(np.sqrt(np.mean(error[mask] ** 2))) for name, mask in
                 (("all", geometry), ("edges", edges), ("rest", geometry & ~edges))}
         print(f"[measure] {bpy.app.version_string} {scene.render.resolution_x}x"
-              f"{scene.render.resolution_y} hidden_surfaces={hidden} overscan={overscan}: "
+              f"{scene.render.resolution_y} hidden_surfaces={hidden} overscan={overscan}"
+              f"{f' ({band} px)' if band != '' else ''}: "
               f"RMSE {rmse['all']:.4f} (edges {rmse['edges']:.4f}, rest {rmse['rest']:.4f}), "
               f"mean AO {float(ao[geometry].mean()):.4f} vs {float(reference[geometry].mean()):.4f}",
               flush=True)

@@ -826,6 +826,46 @@ class AddonTest(unittest.TestCase):
         self.assertLess(r["mean"], 0.97)
         self.assertTrue(r["same"])
 
+    def test_band_follows_the_radius(self):
+        # overscan_mode 'RADIUS' (the default): the band is half the radius's reach in pixels
+        # beyond the frame's edges, so it grows with the resolution (a fixed 64 px got 38 % of
+        # the band's gain at 3840x2160, docs/blender.md). Setting `overscan` gives the band in
+        # pixels, and a file saved with an overscan before the mode existed keeps it.
+        folder = self.folder("band")
+        blend = self.blender.build_scene("band/scene", *ONE_LAYER[:2], "--output",
+                                         os.path.join(folder, "out_####.png"))
+        result = os.path.join(folder, "result.json")
+        script = (
+            "import bpy, json, sys\n"
+            "compute = next(m for n, m in sys.modules.items() "
+            "if n.endswith('ssao_compositor.compute'))\n"
+            "scene = bpy.context.scene\n"
+            "node = compute.ssao_nodes(scene)[0]\n"
+            "out = {'mode': node.overscan_mode}\n"
+            "for percent in (100, 400):\n"
+            "    scene.render.resolution_percentage = percent\n"
+            "    ao = compute.compute_ao(scene)\n"
+            "    depth = compute.read_export(compute.inner_tree.export_path(node, 1))\n"
+            "    out[percent] = compute.band_width(node, scene, depth[::-1, :, 3])\n"
+            "node.overscan = 16\n"
+            "out['set'] = [node.overscan_mode, compute.band_width(node, scene, depth[::-1, :, 3])]\n"
+            "del node['overscan_mode']\n"
+            "node['overscan'] = 32\n"
+            "compute.configure_node(node)\n"
+            "out['loaded'] = [node.overscan_mode, node.overscan]\n"
+            f"json.dump(out, open({result!r}, 'w'))\n")
+        self.blender.run(blend, "--python-exit-code", "1", "--python-expr", script,
+                         env={"SSAO_COMPOSITOR_EXPORT_DIR": os.path.join(folder, "export")})
+        with open(result) as f:
+            r = json.load(f)
+        print(f"\n[measure] band from the radius: {r['100']} px at 160x90, {r['400']} px at "
+              "640x360", file=sys.stderr)
+        self.assertEqual(r["mode"], "RADIUS")
+        self.assertGreater(r["100"], 0)
+        self.assertAlmostEqual(r["400"] / r["100"], 4.0, delta=0.5)
+        self.assertEqual(r["set"], ["PIXELS", 16])
+        self.assertEqual(r["loaded"], ["PIXELS", 32])
+
     def test_threads_follow_a_fixed_render_thread_count(self):
         script = ("import bpy, sys\n"
                   "compute = next(m for n, m in sys.modules.items() "
