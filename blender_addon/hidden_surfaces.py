@@ -35,7 +35,7 @@ HOLDOUT_PROPERTY = "ssao_helper_holdout"
 MAX_HITS = 3
 # The open-surface test (_hits_group): inside rays per surface, and how far they look (scene
 # units; a closed mesh is met within its own size).
-OPEN_SAMPLES = 4
+OPEN_SAMPLES = 1
 # Transparent depths recorded beyond `hits` (_slots).
 EXTRA_SLOTS = 1
 OPEN_DISTANCE = 1e4

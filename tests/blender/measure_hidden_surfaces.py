@@ -4,10 +4,14 @@ render, on the test scene (light) and on the same scene with a mesh of about 2M 
 (docs/blender.md, "Hidden surfaces and overscan"):
 
     blender -b --factory-startup -P tests/blender/measure_hidden_surfaces.py -- \\
-        [--width 640 --height 360 --samples 16 --triangles 2000000 --rounds 3]
+        [--width 640 --height 360 --samples 16 --triangles 2000000 --rounds 3] [--cutouts]
+        [--baseline CHECKOUT]
 
 Prints one `[measure]` line per case: the beauty render's time (Cycles, CPU) and the helper's
 (3 hits, with and without a guard band), medians of --rounds after one warm-up, in one Blender.
+With --baseline CHECKOUT (e.g. a `git worktree` of an earlier commit), the helper of that
+checkout's blender_addon/ and this one's instead, interleaved, and their ratio. --cutouts adds
+the cut-out scene's fence, leaves and curtain.
 """
 import argparse
 import importlib
@@ -37,6 +41,12 @@ def parse_args():
     parser.add_argument("--overscan", type=int, default=32)
     parser.add_argument("--persistent", action="store_true",
                         help="Render Properties > Performance > Persistent Data on")
+    parser.add_argument("--cutouts", action="store_true",
+                        help="add make_reference_scene.build_cutouts (alpha: the helper runs the "
+                             "materials' own outputs)")
+    parser.add_argument("--baseline", default=None, metavar="CHECKOUT",
+                        help="instead, compare the helper (3 hits) with another checkout's "
+                             "blender_addon/, interleaved (A B A B), medians of --rounds")
     return parser.parse_args(argv)
 
 
@@ -82,6 +92,41 @@ def measure(scene, label, args):
           f"{results[1, args.overscan]:.2f} s (Blender {bpy.app.version_string})", flush=True)
 
 
+def compare(scene, label, args, baseline):
+    """The helper render (3 hits, no band) of this checkout against `baseline`'s, interleaved."""
+    times = {"baseline": [], "this": []}
+    modules = {"baseline": baseline, "this": hidden_surfaces}
+
+    def helper(name):
+        for module in modules.values():
+            module.remove_helpers()
+        start = time.perf_counter()
+        modules[name].render_layers(scene, 3, 0)
+        return time.perf_counter() - start
+
+    for name in modules:  # warm-up
+        helper(name)
+    for _ in range(args.rounds):
+        for name in modules:
+            times[name].append(helper(name))
+    base, this = (statistics.median(times[n]) for n in ("baseline", "this"))
+    print(f"[measure] {label}: helper 3 hits, baseline {base:.3f} s, this {this:.3f} s "
+          f"(ratio {this / base:.3f}; medians of {args.rounds}, interleaved; Blender "
+          f"{bpy.app.version_string})", flush=True)
+
+
+def baseline_module(checkout):
+    """blender_addon.hidden_surfaces of another checkout, imported beside this one's."""
+    import importlib.util
+    folder = os.path.join(os.path.abspath(checkout), "blender_addon")
+    spec = importlib.util.spec_from_file_location(
+        "baseline_addon", os.path.join(folder, "__init__.py"), submodule_search_locations=[folder])
+    package = importlib.util.module_from_spec(spec)
+    sys.modules["baseline_addon"] = package
+    # Only the modules hidden_surfaces needs (the package's __init__ registers the add-on).
+    return importlib.import_module("baseline_addon.hidden_surfaces")
+
+
 def main():
     args = parse_args()
     scene = bpy.context.scene
@@ -101,9 +146,14 @@ def main():
     render.use_persistent_data = args.persistent
     size = f"{args.width}x{args.height}, {args.samples} spp" + \
         (", persistent data" if args.persistent else "")
-    measure(scene, f"test scene ({size})", args)
+    if args.cutouts:
+        reference.build_cutouts(scene)
+    run = measure if args.baseline is None else \
+        (lambda s, label, a, b=baseline_module(args.baseline): compare(s, label, a, b))
+    name = "test scene" + (" with cut-outs" if args.cutouts else "")
+    run(scene, f"{name} ({size})", args)
     triangles = heavy_mesh(scene, args.triangles)
-    measure(scene, f"test scene + {triangles / 1e6:.1f}M triangles ({size})", args)
+    run(scene, f"{name} + {triangles / 1e6:.1f}M triangles ({size})", args)
 
 
 if __name__ == "__main__":
