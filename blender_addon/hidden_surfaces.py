@@ -2,22 +2,26 @@
 """The surfaces the render does not show, and a guard band: a helper render of the scene on the
 same pixel grid, with Cycles at 1 sample per pixel whatever engine the beauty uses.
 
-It gives, for each pixel, the depth of the 1st, 2nd and 3rd surface hit along the camera ray,
-whether each is a back face, and the 1st hit's world-space normal; with a guard band of G pixels
-it renders W+2G x H+2G pixels, the frame widened on the same grid.
+It gives, for each pixel, the surfaces along the camera ray as the beauty's rays meet them
+(alpha holes skipped, material displacement applied, ending at a holdout), each a front or a
+back face, an open surface (a card) with something behind it as a front and a back face at its
+depth, and the 1st surface's world-space normal; with a guard band of G pixels it renders
+W+2G x H+2G pixels, the frame (or the render border's crop) widened on the same grid.
 
-How (measured facts: docs/blender.md, "Hidden surfaces and overscan"): one view layer whose
-material override is a Transparent BSDF for every surface, so that the camera ray passes every
-surface, with AOV outputs that write, at the surface whose Light Path > Transparent Depth is
-k - 1 (hit k), Camera Data > View Z Depth (Blender's planar Depth) and Geometry > Backfacing.
-Cycles writes a camera ray's AOVs at every transparent surface it passes (up to the first
-opaque one, and here there is none), and at 1 sample each pixel has one ray. One view layer, so
+How (measured facts: docs/blender.md, "Hidden surfaces and overscan"): one view layer, every
+surface running one node group (_hits_group): a Transparent BSDF, so that the camera ray passes
+every surface, with AOV outputs written at the surface whose Light Path > Transparent Depth is
+j. Cycles writes a camera ray's AOVs at every transparent surface it passes (up to the first
+opaque one, and here there is none), and at 1 sample each pixel has one ray. The group runs as
+the view layer's material override, or, when a material's alpha or displacement matters, from
+an output added to every material for the render only (_MaterialOutputs). One view layer, so
 the scene is synchronised once (every view layer synchronises it again).
 
 The scene, its view layers, its camera and its file are not changed: the render is of a hidden
 helper scene `.SSAO layers <scene>` that links the scene's collections, with a camera object of
-its own set from the scene's camera. Like recomposite.py's, the helper is kept and reused
-(removing a scene in a render handler crashes) and removed before a file is saved."""
+its own set from the scene's camera; what it adds to materials and holdout objects for the
+render is removed after it. Like recomposite.py's, the helper is kept and reused (removing a
+scene in a render handler crashes) and removed before a file is saved."""
 import os
 
 import bpy
