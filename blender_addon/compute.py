@@ -124,9 +124,9 @@ def configure_node(node, folder=None):
     size."""
     scene = node.id_data and scene_of_tree(node.id_data)
     size = camera_module.render_size(scene) if scene is not None else None
-    if "overscan" in node.keys() and "overscan_mode" not in node.keys():
+    if node.is_property_set("overscan") and not node.is_property_set("overscan_mode"):
         # Saved before the band could follow the radius, with a band in pixels: kept.
-        node["overscan_mode"] = 1  # 'PIXELS' (a stored enum is its item's index)
+        node.overscan_mode = 'PIXELS'
     inner_tree.configure(node, folder or export_dir(), size)
 
 

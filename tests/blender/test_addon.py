@@ -849,8 +849,9 @@ class AddonTest(unittest.TestCase):
             "    out[percent] = compute.band_width(node, scene, depth[::-1, :, 3])\n"
             "node.overscan = 16\n"
             "out['set'] = [node.overscan_mode, compute.band_width(node, scene, depth[::-1, :, 3])]\n"
-            "del node['overscan_mode']\n"
-            "node['overscan'] = 32\n"
+            "node.overscan = 32\n"
+            "node.property_unset('overscan_mode')  # as saved before the mode existed\n"
+            "out['unset'] = node.overscan_mode\n"
             "compute.configure_node(node)\n"
             "out['loaded'] = [node.overscan_mode, node.overscan]\n"
             f"json.dump(out, open({result!r}, 'w'))\n")
@@ -864,6 +865,7 @@ class AddonTest(unittest.TestCase):
         self.assertGreater(r["100"], 0)
         self.assertAlmostEqual(r["400"] / r["100"], 4.0, delta=0.5)
         self.assertEqual(r["set"], ["PIXELS", 16])
+        self.assertEqual(r["unset"], "RADIUS")
         self.assertEqual(r["loaded"], ["PIXELS", 32])
 
     def test_threads_follow_a_fixed_render_thread_count(self):
