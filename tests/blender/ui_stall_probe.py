@@ -1,0 +1,81 @@
+# SPDX-License-Identifier: MIT
+"""How long Blender's UI stops responding during an F12 with the Ambient Occlusion (SSAO) node
+(issue 33: the helper render runs on the main thread). In the UI (under Xvfb): a timer probe
+asks to run every 20 ms; F12 renders the open scene; when the render, the AO and the re-composite
+are done, the longest gaps between two probe runs (the main thread's stalls) are written to a
+JSON report and printed, then Blender quits.
+
+    xvfb-run -a -s "-screen 0 1280x720x24" blender --factory-startup -noaudio \\
+        --addons ssao_compositor SCENE.blend --python tests/blender/ui_stall_probe.py -- OUT.json
+
+SCENE.blend: a scene whose compositor has the SSAO node (tests/blender/build_ssao_scene.py;
+tests/blender/measure_hidden_surfaces.py's heavy_mesh for the 2M-triangle case)."""
+import json
+import os
+import sys
+import time
+import traceback
+
+import bpy
+
+REPORT = sys.argv[sys.argv.index("--") + 1]
+PERIOD = 0.02
+TIMEOUT = 600.0
+STATE = {"ticks": [], "f12": None, "idle_since": None, "start": time.monotonic()}
+
+
+def addon_module(name):
+    return next(m for n, m in sys.modules.items() if n.endswith("ssao_compositor." + name))
+
+
+def probe():
+    STATE["ticks"].append(time.monotonic())
+    return PERIOD
+
+
+def busy():
+    handlers = addon_module("handlers")
+    return bpy.app.is_job_running('RENDER') or bool(handlers._pending_frames or
+                                                    handlers._written_frames)
+
+
+def finish(code):
+    ticks = [t for t in STATE["ticks"] if STATE["f12"] is not None and t >= STATE["f12"]]
+    gaps = sorted((b - a for a, b in zip(ticks, ticks[1:])), reverse=True)
+    node = addon_module("compute").ssao_nodes(bpy.context.scene)[0]
+    report = {"blender": bpy.app.version_string, "longest_stall_s": gaps[0] if gaps else None,
+              "next_stalls_s": gaps[1:5], "f12_to_idle_s": (ticks[-1] - ticks[0]) if ticks
+              else None, "status": node.status}
+    with open(REPORT, "w") as f:
+        json.dump(report, f, indent=1)
+    print(f"[measure] UI stall during F12: {report}", flush=True)
+    os._exit(code)  # Blender's own shutdown can hang under Xvfb
+
+
+def step():
+    try:
+        now = time.monotonic()
+        if now - STATE["start"] > TIMEOUT:
+            finish(1)
+        if STATE["f12"] is None:
+            window = bpy.context.window_manager.windows[0]
+            with bpy.context.temp_override(window=window):
+                bpy.ops.render.render('INVOKE_DEFAULT')
+            STATE["f12"] = time.monotonic()
+            return 1.0
+        node = addon_module("compute").ssao_nodes(bpy.context.scene)[0]
+        if busy() or not node.status:
+            STATE["idle_since"] = None
+            return 0.5
+        if STATE["idle_since"] is None:  # idle twice, a second apart
+            STATE["idle_since"] = now
+            return 1.0
+        finish(0)
+    except Exception:
+        traceback.print_exc()
+        finish(1)
+    return None
+
+
+bpy.app.timers.register(probe, first_interval=1.0)
+bpy.app.timers.register(step, first_interval=3.0)
