@@ -249,6 +249,12 @@ def _needs_own(material):
     return moved or not (isinstance(alpha, float) and alpha >= 1.0)
 
 
+def _editable_materials():
+    """The materials the helper may give an output of its own: the file's own (a library's
+    cannot be edited), not the helper's override."""
+    return [m for m in bpy.data.materials if m.library is None and m.name != MATERIAL_NAME]
+
+
 class _Holdouts:
     """While open, the objects that are holdouts in the user's view layer (their own setting
     or their collection's) carry HOLDOUT_PROPERTY = 1, which the hits group reads (an
@@ -287,9 +293,8 @@ class _MaterialOutputs:
 
     def __enter__(self):
         try:
-            for material in bpy.data.materials:
-                if material.library is None and material.name != MATERIAL_NAME:
-                    self._add(material)
+            for material in _editable_materials():
+                self._add(material)
         except BaseException:
             self.__exit__(None, None, None)
             raise
@@ -392,8 +397,7 @@ def _camera_copy(scene, helper, overscan):
     obj = bpy.data.objects.get(name) or bpy.data.objects.new(name, data)
     obj.data = data
     settings = source.data
-    for attribute in ("type", "lens", "sensor_width", "sensor_height", "sensor_fit", "shift_x",
-                      "shift_y", "ortho_scale", "clip_start", "clip_end"):
+    for attribute in ("type", "lens", "clip_start", "clip_end"):
         setattr(data, attribute, getattr(settings, attribute))
     data.dof.use_dof = False  # the depth of the pixel's centre ray, not of a lens sample
     # The rendered image (the crop of a render cropped to its border) widened by the band, as a
@@ -404,11 +408,6 @@ def _camera_copy(scene, helper, overscan):
         setattr(data, name, value)
     obj.matrix_world = source.matrix_world.copy()
     return obj
-
-
-def render_size(render):
-    """The rendered image's size (the crop's when the render is cropped to its border)."""
-    return camera_module.crop_window(render)[2:]
 
 
 def _view_layer(scene):
@@ -439,13 +438,14 @@ def helper_scene(scene, hits, overscan, own_materials):
     # With the materials' own outputs, a surface without one (no material, a linked or
     # non-node material) stops the ray as in the beauty: its depth and normal are the passes'.
     layer.use_pass_z = layer.use_pass_normal = own_materials
-    layer.pass_alpha_threshold = _alpha_threshold(scene)
+    threshold = _alpha_threshold(scene)
+    layer.pass_alpha_threshold = threshold
     for aov in _aov_names(hits):
         if aov not in layer.aovs:
             item = layer.aovs.add()
             item.name = aov
             item.type = 'COLOR' if aov == "normal" else 'VALUE'
-    group = _hits_group(hits, _alpha_threshold(scene))
+    group = _hits_group(hits, threshold)
     layer.material_override = None if own_materials else _override_material(group)
     _render_settings(scene, helper, hits, overscan)
     return helper, group
@@ -453,7 +453,7 @@ def helper_scene(scene, hits, overscan, own_materials):
 
 def _render_settings(scene, helper, hits, overscan):
     render, source = helper.render, scene.render
-    width, height = render_size(source)
+    width, height = camera_module.render_size(scene)
     render.engine = 'CYCLES'
     render.resolution_x, render.resolution_y = width + 2 * overscan, height + 2 * overscan
     render.resolution_percentage = 100
@@ -514,6 +514,12 @@ def _planes(path, hits, own_materials):
     return layers
 
 
+def _bit_planes(plane, slots):
+    """(slots, height, width) booleans: bit j of an AOV that sums 2^j over the surfaces."""
+    bits = np.rint(plane).astype(np.int64)
+    return np.stack([(bits >> j) & 1 for j in range(slots)]).astype(bool)
+
+
 def surfaces(raw, hits, own_materials):
     """The surfaces along each pixel's ray from the helper's planes, in order: (depth, facing)
     arrays of shape (hits, height, width), BACKGROUND / 0 past the last, and the first
@@ -530,14 +536,12 @@ def surfaces(raw, hits, own_materials):
     beyond the AOVs' hits) is a front face. At most `hits` entries, twins included (a twin
     takes the place of a farther surface: with 5 entries rather than 3 the cut-out scene's
     AO was no closer to Cycles', docs/blender.md)."""
-    signed = np.stack([raw[f"hit{j}"] for j in range(_slots(hits))])
-    open_bits = np.rint(raw["open"]).astype(np.int64)
-    is_open = np.stack([(open_bits >> j) & 1 for j in range(_slots(hits))]).astype(bool)
+    slots = _slots(hits)
+    signed = np.stack([raw[f"hit{j}"] for j in range(slots)])
+    is_open = _bit_planes(raw["open"], slots)
     found = signed != 0
     # The ray ends at its first holdout: nothing from there on is seen.
-    stop_bits = np.rint(raw["stop"]).astype(np.int64)
-    stopped_at = np.stack([(stop_bits >> j) & 1 for j in range(_slots(hits))]).astype(bool)
-    ended = np.logical_or.accumulate(stopped_at, axis=0)
+    ended = np.logical_or.accumulate(_bit_planes(raw["stop"], slots), axis=0)
     found &= ~ended
     depth = np.abs(signed)
     # Something behind each slot: a later slot's surface, or the surface that stopped the ray.
@@ -545,30 +549,22 @@ def surfaces(raw, hits, own_materials):
     later[:-1] = np.flip(np.logical_or.accumulate(np.flip(found[1:], 0), axis=0), 0)
     if own_materials:
         stop = np.where(ended[-1], 0, raw["Depth"])
-        later |= ((stop > 0) & (stop < BACKGROUND * 0.5))[None]
+        stopped = (stop > 0) & (stop < BACKGROUND * 0.5)
+        later |= stopped[None]
     back = (signed < 0) & ~is_open  # an open surface is never read as leaving a solid
     is_open &= later
-    # Each slot: its surface, then its card twin (a back face at the same depth).
-    parts_depth = [depth, depth]
-    parts_facing = [back.astype(np.float32), np.ones_like(depth)]
-    parts_found = [found, found & is_open]
+    # Slot by slot, its surface then its card twin (a back face at the same depth), in ray
+    # order; then the surface that stopped the ray.
+    rows = (-1,) + depth.shape[1:]
+    order_depth = np.stack([depth, depth], axis=1).reshape(rows)
+    order_facing = np.stack([back.astype(np.float32), np.ones_like(depth)], axis=1).reshape(rows)
+    order_found = np.stack([found, found & is_open], axis=1).reshape(rows)
     normal = raw["normal"]
     if own_materials:
-        stop = stop[None]
-        stopped = (stop > 0) & (stop < BACKGROUND * 0.5)
-        parts_depth.append(stop)
-        parts_facing.append(np.zeros_like(stop))
-        parts_found.append(stopped)
-        no_aov_normal = ~found.any(axis=0)
-        normal = np.where(no_aov_normal[..., None], raw["Normal"], normal)
-    # Interleave slot by slot (surface, twin), keeping ray order; then the ray's stop.
-    order_depth = np.stack(parts_depth[:2], axis=1).reshape(-1, *depth.shape[1:])
-    order_facing = np.stack(parts_facing[:2], axis=1).reshape(-1, *depth.shape[1:])
-    order_found = np.stack(parts_found[:2], axis=1).reshape(-1, *depth.shape[1:])
-    if own_materials:
-        order_depth = np.concatenate([order_depth, parts_depth[2]])
-        order_facing = np.concatenate([order_facing, parts_facing[2]])
-        order_found = np.concatenate([order_found, parts_found[2]])
+        order_depth = np.concatenate([order_depth, stop[None]])
+        order_facing = np.concatenate([order_facing, np.zeros_like(stop)[None]])
+        order_found = np.concatenate([order_found, stopped[None]])
+        normal = np.where(~found.any(axis=0)[..., None], raw["Normal"], normal)
     first = np.argsort(~order_found, axis=0, kind="stable")[:hits]
     kept = np.take_along_axis(order_found, first, axis=0)
     out_depth = np.where(kept, np.take_along_axis(order_depth, first, axis=0),
@@ -597,13 +593,12 @@ def render_layers(scene, hits=MAX_HITS, overscan=0, folder=None):
     if overscan < 0:
         raise ValueError(f"overscan must be 0 or more pixels, not {overscan}")
     camera = scene.camera
-    key = (scene.frame_current, hits, overscan, render_size(scene.render),
+    key = (scene.frame_current, hits, overscan, camera_module.render_size(scene),
            camera and tuple(map(tuple, camera.matrix_world)))
     cached = _cache.setdefault(scene.name, {})
     if key in cached:
         return cached[key]
-    own_materials = any(_needs_own(m) for m in bpy.data.materials
-                        if m.library is None and m.name != MATERIAL_NAME)
+    own_materials = any(_needs_own(m) for m in _editable_materials())
     helper, group = helper_scene(scene, hits, overscan, own_materials)
     folder = folder or bpy.app.tempdir
     os.makedirs(folder, exist_ok=True)
