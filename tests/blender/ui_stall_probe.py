@@ -42,10 +42,10 @@ def busy():
 def finish(code):
     ticks = [t for t in STATE["ticks"] if STATE["f12"] is not None and t >= STATE["f12"]]
     gaps = sorted((b - a for a, b in zip(ticks, ticks[1:])), reverse=True)
-    node = addon_module("compute").ssao_nodes(bpy.context.scene)[0]
+    nodes = addon_module("compute").ssao_nodes(bpy.context.scene)
     report = {"blender": bpy.app.version_string, "longest_stall_s": gaps[0] if gaps else None,
               "next_stalls_s": gaps[1:5], "f12_to_idle_s": (ticks[-1] - ticks[0]) if ticks
-              else None, "status": node.status}
+              else None, "status": nodes[0].status if nodes else "no active SSAO node"}
     with open(REPORT, "w") as f:
         json.dump(report, f, indent=1)
     print(f"[measure] UI stall during F12: {report}", flush=True)
@@ -63,8 +63,8 @@ def step():
                 bpy.ops.render.render('INVOKE_DEFAULT')
             STATE["f12"] = time.monotonic()
             return 1.0
-        node = addon_module("compute").ssao_nodes(bpy.context.scene)[0]
-        if busy() or not node.status:
+        nodes = addon_module("compute").ssao_nodes(bpy.context.scene)
+        if busy() or (nodes and not nodes[0].status):
             STATE["idle_since"] = None
             return 0.5
         if STATE["idle_since"] is None:  # idle twice, a second apart
