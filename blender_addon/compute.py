@@ -9,7 +9,7 @@ import bpy
 import numpy as np
 
 from . import camera as camera_module
-from . import compat, hidden_surfaces, inner_tree, ssao
+from . import compat, helper_process, hidden_surfaces, inner_tree, ssao
 
 # Where exporters write (per process; $SSAO_COMPOSITOR_EXPORT_DIR or the add-on's preference
 # override it, e.g. to keep the passes for the command-line tool). Saved files carry
@@ -296,11 +296,13 @@ def threads(scene):
     return render.threads if render.threads_mode == 'FIXED' else 0
 
 
-def compute_node(node, scene, passes):
+def compute_node(node, scene, passes, wait=True):
     """AO of `node` from exported `passes` (read_export's: normal xyz, depth[, the Image's
     alpha]); fills the node's AO image (with the composite's factor: inner_tree.py) and returns
     the AO with row 0 on top. Raises, leaving the AO image as it was, when the inputs, the
-    parameters or the library cannot give this frame's AO."""
+    parameters or the library cannot give this frame's AO. With wait=False (the UI) a helper
+    render the node needs is asked of helper_process and, until its layers come, the AO is
+    computed without them (waiting_status())."""
     use_normals = check_inputs(node)
     check_parameters(node)
     lib = library()  # before the helper render (library_inputs): a missing library renders none
@@ -312,7 +314,7 @@ def compute_node(node, scene, passes):
         check_normals(scene, passes, min(background, camera["clip_end"] or math.inf))
     rgba, outputs = inner_tree.library_outputs(passes)
     # Blender's rows run bottom-up, the library's top-down: flipped views read in place.
-    images, overscan = library_inputs(node, scene, passes, use_normals)
+    images, overscan = library_inputs(node, scene, passes, use_normals, wait)
     with ssao.Job(lib) as job:
         for name, value in camera.items():
             job.set(name, value)
@@ -331,17 +333,25 @@ def compute_node(node, scene, passes):
     return np.ascontiguousarray(rgba[::-1, :, 0])
 
 
-def library_inputs(node, scene, passes, use_normals):
+def library_inputs(node, scene, passes, use_normals, wait=True):
     """({library image name: array, row 0 on top}, overscan in pixels) for `passes`: the
     user's Depth (and Normal), and, when the node asks for hidden surfaces or a guard band, the
-    helper render's layers of the scene's current frame (hidden_surfaces.py). In the band the
+    helper render's layers of the scene's current frame (hidden_surfaces.py; with wait=False
+    and the helper in its own process, only once helper_process has them). In the band the
     helper's depth and normal stand in for the user's; inside it the user's passes are kept."""
     depth, normal = passes[::-1, :, 3], passes[::-1, :, 0:3]
     hits = HITS[getattr(node, "hidden_surfaces", 'NONE')]
     overscan = band_width(node, scene, depth)
+    user_passes = {"depth": depth, **({"normal": normal} if use_normals else {})}
     if hits == 1 and not overscan:
-        return {"depth": depth, **({"normal": normal} if use_normals else {})}, 0
-    layers = hidden_surfaces.render_layers(scene, hits, overscan, folder=export_dir())
+        helper_process.withdraw(scene.name, node.name)
+        return user_passes, 0
+    if wait or not helper_process.enabled:
+        layers = hidden_surfaces.render_layers(scene, hits, overscan, folder=export_dir())
+    else:
+        layers = helper_process.layers_or_request(scene, hits, overscan, node.name)
+        if layers is None:
+            return user_passes, 0
     height, width = depth.shape
     inside = (slice(overscan, overscan + height), slice(overscan, overscan + width))
     full_depth = layers["depth"].copy()
@@ -404,12 +414,19 @@ def _extra_layers(depth, layers, hits):
     return images
 
 
-def compute_frame(scene, frame, since=0.0, outcome="written"):
+def waiting_status(node, scene, frame):
+    """The node's status while helper_process renders the layers it asked for, else None."""
+    if helper_process.waiting(scene.name, node.name):
+        return f"Rendering hidden surfaces for frame {frame}; the AO without them meanwhile"
+    return None
+
+
+def compute_frame(scene, frame, since=0.0, outcome="written", wait=True):
     """Computes every SSAO node of `scene` from its export of `frame` written since `since` (a
     time.time(); a render that started before the add-on turned a saved file's group nodes
     back into SSAO nodes exports where the file was saved). Returns {node name: AO, or None
     where it failed}. A node that failed gets an AO of 1 (the frame is `outcome` without its
-    AO), and the error is reported on the node and in the console."""
+    AO), and the error is reported on the node and in the console. wait: compute_node's."""
     done = {}
     for node in ssao_nodes(scene):
         # A render of this session may have exported where a saved file points (see above).
@@ -423,9 +440,10 @@ def compute_frame(scene, frame, since=0.0, outcome="written"):
                                    f"no exported passes for frame {frame} (is the node's output "
                                    "connected to the compositor's output?)")
             start = time.perf_counter()
-            ao = compute_node(node, scene, read_export(path))
+            ao = compute_node(node, scene, read_export(path), wait)
             seconds = time.perf_counter() - start
-            node.status = f"Frame {frame}: {ao.shape[1]}x{ao.shape[0]} in {seconds * 1e3:.0f} ms"
+            node.status = waiting_status(node, scene, frame) or \
+                f"Frame {frame}: {ao.shape[1]}x{ao.shape[0]} in {seconds * 1e3:.0f} ms"
             report(f"{scene.name} frame {frame} node '{node.name}': {node.status}, "
                    f"mean AO {float(ao.mean()):.4f}")
             done[node.name] = ao

@@ -23,8 +23,8 @@ import time
 
 import bpy
 
-from . import compat, compute, hidden_surfaces, inner_tree, main_thread, recomposite, \
-    saved_form
+from . import compat, compute, helper_process, hidden_surfaces, inner_tree, main_thread, \
+    recomposite, saved_form
 from .compute import report
 
 _pending_frames = []    # UI: (scene name, frame) rendered, waiting for the main-thread timer
@@ -86,7 +86,9 @@ def _on_render_pre(scene, *_):
     global _render_started
     if _helper_rendering():
         return
-    hidden_surfaces.forget(scene.name)  # a new render: the layers kept are of the last one
+    # A new render: the layers kept, or being rendered, are of the last one.
+    hidden_surfaces.forget(scene.name)
+    helper_process.cancel(scene.name)
     if bpy.app.background or not _written_frames:  # (the UI: the animation's first frame)
         _render_started = time.time() - 1.0  # file times may be rounded to the second
     if not bpy.app.background:
@@ -244,9 +246,31 @@ def _process_pending():
         rendering = bpy.app.is_job_running('RENDER')
         if not rendering and (_written_frames or _pending_frames):
             with_writes(_finish_rendered_frames)
+        if helper_process.busy():
+            _poll_helpers()
     except Exception as error:
         report(f"after the render: {error}", error=True)
-    return 0.05 if rendering else 0.2
+    return 0.05 if rendering else 0.1 if helper_process.busy() else 0.2
+
+
+def _poll_helpers():
+    """UI: the helper renders' progress (helper_process); a scene whose layers came (or whose
+    helper failed) is computed again. Polling writes nothing: with_writes (a window-manager
+    property's update) redraws Blender's windows, which every 0.1 s kept a core busy."""
+    for scene_name, frame in helper_process.poll().items():
+        scene = bpy.data.scenes.get(scene_name)
+        if scene is not None and compute.ssao_nodes(scene):
+            with_writes(lambda: _answered(scene, frame))
+
+
+def _answered(scene, frame):
+    if scene.frame_current == frame:
+        _show_frame(scene, frame)
+        return
+    for node in compute.ssao_nodes(scene):
+        if node.status.startswith("Rendering hidden surfaces"):
+            node.status = (f"Frame {frame}: without hidden surfaces (the frame changed before "
+                           "they rendered)")
 
 
 def _finish_rendered_frames():
@@ -281,13 +305,21 @@ def _finish_rendered_frames():
     scene = bpy.data.scenes.get(last[0]) if last else None
     if scene is None or not compute.ssao_nodes(scene):
         return
-    # The Render Result shows the last frame rendered; after an animation the scene is back
-    # at its own frame: that frame's camera for the AO, then the scene as it was.
+    _show_frame(scene, last[1])
+
+
+def _show_frame(scene, frame):
+    """UI: the AO of the Render Result's frame, re-composited. The helper render a node needs
+    renders in its own process (helper_process): the node shows the AO without it meanwhile,
+    and this runs again when it is done. After an animation the Render Result shows its last
+    frame and the scene is back at its own: that frame's camera for the AO (its helper
+    rendered here, at once), then the scene as it was."""
     current = scene.frame_current
     try:
-        if last[1] != current:
-            scene.frame_set(last[1])
-        aos = compute.compute_frame(scene, last[1], _render_started, outcome="shown")
+        if frame != current:
+            scene.frame_set(frame)
+        aos = compute.compute_frame(scene, frame, _render_started, outcome="shown",
+                                    wait=frame != current)
     finally:
         if scene.frame_current != current:
             scene.frame_set(current)
@@ -298,7 +330,9 @@ def _finish_rendered_frames():
             message = ("AO computed; open a compositor Node Editor (and an Image Editor "
                        "showing Render Result) to see it applied")
             for node in compute.ssao_nodes(scene):
-                if aos.get(node.name) is not None:  # a failed node keeps its error
+                # A failed node keeps its error, a waiting one says so.
+                if aos.get(node.name) is not None and \
+                        not helper_process.waiting(scene.name, node.name):
                     node.status = message
             report(message)
 
@@ -361,8 +395,9 @@ def parameter_changed(node, scene):
         node.status = "Render (F12) to compute the AO"
         return
     try:
-        compute.compute_node(node, scene, compute.read_export(path))
-        node.status = f"Frame {scene.frame_current}: recomputed"
+        compute.compute_node(node, scene, compute.read_export(path), wait=False)
+        node.status = compute.waiting_status(node, scene, scene.frame_current) or \
+            f"Frame {scene.frame_current}: recomputed"
     except Exception as error:
         compute.without_ao(node, scene)
         node.status = f"Error: {error}"
@@ -400,6 +435,7 @@ def _pack_and_point_at_saved_folder(scene, node):
 
 @bpy.app.handlers.persistent
 def _on_load_post(*_):
+    helper_process.cancel()  # another file: its scenes are others, even under the same names
     set_up_nodes()
 
 
@@ -444,6 +480,7 @@ def register():
 
 def unregister():
     main_thread.stop()  # a render thread waiting for the timer goes on without its work
+    helper_process.cancel()
     for timer in (_process_pending, _check_nudge):
         if bpy.app.timers.is_registered(timer):
             bpy.app.timers.unregister(timer)

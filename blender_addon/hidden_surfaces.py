@@ -25,6 +25,7 @@ scene in a render handler crashes) and removed before a file is saved."""
 import os
 
 import bpy
+import mathutils
 import numpy as np
 
 from . import camera as camera_module
@@ -386,9 +387,10 @@ def _copy_layer_flags(source, target):
             _copy_layer_flags(match, child)
 
 
-def _camera_copy(scene, helper, overscan):
+def _camera_copy(scene, helper, overscan, matrix=None):
     """The helper's camera: the scene's active camera as it is now (matrix and settings, not its
-    animation), widened by `overscan` pixels on every side on the same pixel grid."""
+    animation; `matrix`, its matrix_world as rows, in place of its own), widened by `overscan`
+    pixels on every side on the same pixel grid."""
     source = scene.camera
     if source is None:
         raise RuntimeError(f"scene '{scene.name}' has no active camera")
@@ -406,7 +408,8 @@ def _camera_copy(scene, helper, overscan):
         {name: getattr(settings, name) for name in camera_module.CROPPED}, scene.render, overscan)
     for name, value in framed.items():
         setattr(data, name, value)
-    obj.matrix_world = source.matrix_world.copy()
+    obj.matrix_world = source.matrix_world.copy() if matrix is None else \
+        mathutils.Matrix(matrix)
     return obj
 
 
@@ -415,7 +418,7 @@ def _view_layer(scene):
     return next((layer for layer in scene.view_layers if layer.use), scene.view_layers[0])
 
 
-def helper_scene(scene, hits, overscan, own_materials):
+def helper_scene(scene, hits, overscan, own_materials, camera_matrix=None):
     """The hidden scene that renders the layers of `scene` (made once, then brought up to date:
     collections, camera, size, sampling). `own_materials`: the surfaces run their materials'
     own Cycles outputs (_MaterialOutputs) rather than the view layer's override."""
@@ -425,7 +428,7 @@ def helper_scene(scene, hits, overscan, own_materials):
         helper = bpy.data.scenes.new(name)
         compat.render_view_layers_only(helper)
         compat.layer_collection(helper.view_layers[0])  # while the scene is empty (compat)
-    camera = _camera_copy(scene, helper, overscan)
+    camera = _camera_copy(scene, helper, overscan, camera_matrix)
     _sync_collections(helper, scene, camera)
     helper.camera = camera
     helper.background_set = scene.background_set  # the beauty renders the set's objects too
@@ -576,10 +579,32 @@ def surfaces(raw, hits, own_materials):
     return out_depth, out_facing, normal
 
 
-def render_layers(scene, hits=MAX_HITS, overscan=0, folder=None):
+def layers_key(scene, hits, overscan):
+    """What the layers of `scene` as it is now depend on, beyond its contents: the frame, the
+    hits and band asked for, the render's size and the camera's placement."""
+    camera = scene.camera
+    return (scene.frame_current, hits, overscan, camera_module.render_size(scene),
+            camera and tuple(map(tuple, camera.matrix_world)))
+
+
+def kept_layers(scene_name, key):
+    """The layers rendered for `key` (layers_key) and kept, or None."""
+    return _cache.get(scene_name, {}).get(key)
+
+
+def keep(scene_name, key, layers):
+    """Keeps `layers` for `key` until forget(); the oldest go beyond CACHED_PER_SCENE."""
+    cached = _cache.setdefault(scene_name, {})
+    while len(cached) >= CACHED_PER_SCENE:  # an animation's frames must not pile up
+        cached.pop(next(iter(cached)))
+    cached[key] = layers
+
+
+def render_layers(scene, hits=MAX_HITS, overscan=0, folder=None, camera_matrix=None):
     """Renders `scene`'s hidden-surface layers at its current frame (set it first with
-    scene.frame_set: the camera is read as it is). Returns {name: float32 array, row 0 on top},
-    of the render's size + 2 * overscan on each axis:
+    scene.frame_set: the camera is read as it is, or its matrix_world is `camera_matrix`, rows).
+    Returns {name: float32 array, row 0 on top}, of the render's size + 2 * overscan on each
+    axis:
       "depth": the 1st surface's planar depth (BACKGROUND where the ray meets none), "normal":
       its world-space normal (height, width, 3), and for k = 2..hits "depth<k>" (BACKGROUND
       where there is no k-th entry) and "facing<k>" (1 = back face, 0 = front face or none):
@@ -587,19 +612,15 @@ def render_layers(scene, hits=MAX_HITS, overscan=0, folder=None):
     Surfaces are as Cycles' camera rays see them: alpha below the view layer's threshold is a
     hole, material displacement is applied (both where some material needs it: its own
     outputs are run, _MaterialOutputs).
-    The result is kept for the scene and frame until forget(): a recompute does not render."""
-    if not 1 <= hits <= MAX_HITS:
-        raise ValueError(f"hits must be 1 to {MAX_HITS}, not {hits}")
-    if overscan < 0:
-        raise ValueError(f"overscan must be 0 or more pixels, not {overscan}")
-    camera = scene.camera
-    key = (scene.frame_current, hits, overscan, camera_module.render_size(scene),
-           camera and tuple(map(tuple, camera.matrix_world)))
-    cached = _cache.setdefault(scene.name, {})
-    if key in cached:
-        return cached[key]
+    The result is kept for the scene and frame until forget(): a recompute does not render.
+    This renders in Blender's own process; helper_process.py renders the same in another."""
+    check_request(hits, overscan)
+    key = layers_key(scene, hits, overscan)
+    layers = kept_layers(scene.name, key)
+    if layers is not None:
+        return layers
     own_materials = any(_needs_own(m) for m in _editable_materials())
-    helper, group = helper_scene(scene, hits, overscan, own_materials)
+    helper, group = helper_scene(scene, hits, overscan, own_materials, camera_matrix)
     folder = folder or bpy.app.tempdir
     os.makedirs(folder, exist_ok=True)
     path = os.path.join(folder, f"layers_{bpy.path.clean_name(scene.name)}_"
@@ -620,10 +641,15 @@ def render_layers(scene, hits=MAX_HITS, overscan=0, folder=None):
     for k in range(2, hits + 1):
         layers[f"depth{k}"] = depth[k - 1]
         layers[f"facing{k}"] = facing[k - 1]
-    while len(cached) >= CACHED_PER_SCENE:  # an animation's frames must not pile up
-        cached.pop(next(iter(cached)))
-    cached[key] = layers
+    keep(scene.name, key, layers)
     return layers
+
+
+def check_request(hits, overscan):
+    if not 1 <= hits <= MAX_HITS:
+        raise ValueError(f"hits must be 1 to {MAX_HITS}, not {hits}")
+    if overscan < 0:
+        raise ValueError(f"overscan must be 0 or more pixels, not {overscan}")
 
 
 def remove_helpers():

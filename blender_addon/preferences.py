@@ -2,12 +2,16 @@
 """The add-on's preferences: where the passes are exported, and what the library says."""
 import bpy
 
-from . import compute, handlers
+from . import compute, handlers, helper_process
 
 
 def _on_export_dir_changed(preferences, context):
     compute.preferred_export_dir = bpy.path.abspath(preferences.export_dir)
     handlers.set_up_nodes()
+
+
+def _on_helper_process_changed(preferences, context):
+    helper_process.enabled = preferences.helper_process
 
 
 class SSAOPreferences(bpy.types.AddonPreferences):
@@ -20,9 +24,18 @@ class SSAOPreferences(bpy.types.AddonPreferences):
                     "temporary folder removed when Blender quits "
                     "($SSAO_COMPOSITOR_EXPORT_DIR overrides both)")
 
+    helper_process: bpy.props.BoolProperty(
+        name="Helper render in its own process", default=True,
+        update=_on_helper_process_changed,
+        description="In the UI, render the nodes' hidden surfaces and band in a background "
+                    "Blender, so that the UI keeps responding (the scene is loaded a second "
+                    "time while it renders). Off: in this Blender, which stops responding "
+                    "while it renders. Headless renders always render it here")
+
     def draw(self, context):
         layout = self.layout
         layout.prop(self, "export_dir")
+        layout.prop(self, "helper_process")
         try:
             library = compute.library()
             version = library.ssao_version()
@@ -37,6 +50,7 @@ def register():
     addon = bpy.context.preferences.addons.get(__package__)
     if addon is not None and addon.preferences is not None:
         compute.preferred_export_dir = bpy.path.abspath(addon.preferences.export_dir)
+        helper_process.enabled = addon.preferences.helper_process
 
 
 def unregister():

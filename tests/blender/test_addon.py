@@ -404,6 +404,31 @@ class AddonTest(unittest.TestCase):
         self.assertGreaterEqual(agreement["inside"], 0.999, agreement)
         self.assertGreaterEqual(agreement["band"], 0.999, agreement)
 
+    def test_helper_process_renders_what_blender_renders(self):
+        # The helper render in a Blender process of its own (the UI's way, helper_process.py)
+        # on the scene with cut-outs, displacement and holdouts (materials given outputs of
+        # their own, in the copy): its layers equal, bit for bit, those rendered in Blender's
+        # process. A request replaced before it settles starts no process; a new render
+        # cancels a running one (killed, files removed); a failure carries the child's message.
+        result = os.path.join(self.folder("helper_process"), "helper_process.json")
+        blend = self.blender.build_scene("helper_process/scene", "--render-features",
+                                         "--cutouts")
+        log = self.blender.run(blend, "--python-exit-code", "1", "-P",
+                               os.path.join(HERE, "check_helper_process.py"), "--", "--out",
+                               result)
+        print("\n" + "\n".join(line for line in log.splitlines() if "[measure]" in line),
+              file=sys.stderr)
+        with open(result) as f:
+            report = json.load(f)
+        self.assertEqual(report["equal"], {name: True for name in (
+            "depth", "normal", "depth2", "facing2", "depth3", "facing3")}, report)
+        self.assertGreater(report["geometry_pixels"], 1000)
+        self.assertEqual(report["settled"], {"processes": 1, "answered": {"Scene": 1}})
+        self.assertEqual(report["cancelled"], {"exit": -signal.SIGKILL, "files_left": False,
+                                               "busy": False}, report)
+        self.assertIn("has no active camera", report["failure"])
+        self.assertTrue(report["after_failure_asks_again"])
+
     def test_render_border_with_crop(self):
         # A render cropped to its border: the passes are the crop's size, the AO is the crop's
         # (its camera: the frame's, framed to the crop: camera.cropped) and equals the whole
@@ -648,9 +673,10 @@ class AddonTest(unittest.TestCase):
 
     @unittest.skipUnless(shutil.which("xvfb-run"), "needs xvfb-run (apt-get install xvfb)")
     def test_ui_changing_hidden_surfaces_renders_the_helper_again(self):
-        # In the UI, F12 with the defaults (hidden surfaces and a band), then the two settings
-        # changed from the node: each change recomputes (the helper render runs inside the
-        # node's update callback, on the main thread) and the AO changes each time.
+        # In the UI, F12 with the defaults (hidden surfaces and a band), and F12 again while
+        # the first one's helper process renders; then the two settings changed from the node:
+        # each change recomputes (a helper render it needs runs in a process of its own,
+        # helper_process.py) and the AO changes each time.
         folder = self.folder("ui_change")
         blend = self.blender.build_scene("ui_change/scene", "--output",
                                          os.path.join(folder, "out_####.png"))
@@ -661,14 +687,17 @@ class AddonTest(unittest.TestCase):
         with open(report_path) as f:
             report = json.load(f)
         self.assertEqual([r["step"] for r in report], ["after F12", "NONE, 0", "PEELED, 32"])
+        # The second F12 killed the first one's helper process (SIGKILL: -9).
+        self.assertEqual(report[0]["stale_helper_exit"], -signal.SIGKILL, report)
         # The default workspace shows no compositor editor: computed, not shown (see "What the
-        # UI needs for the AO to show after F12").
-        self.assertTrue(report[0]["status"].startswith(("Frame 1: ", "AO computed")), report)
-        for r in report[1:]:
-            self.assertEqual(r["status"], "Frame 1: recomputed", report)
-        # Each assignment recomputes: F12 one helper render; then NONE (band still 64 px) one,
-        # overscan 0 none (nothing to render); then PEELED (no band) one, overscan 32 one.
-        self.assertEqual([r["helper_renders"] for r in report], [1, 2, 4], report)
+        # UI needs for the AO to show after F12"); a change computed at once says so.
+        for r in report:
+            self.assertTrue(r["status"].startswith(("Frame 1: ", "AO computed")), report)
+        self.assertEqual(report[1]["status"], "Frame 1: recomputed", report)
+        # Helper processes: one per F12 (the first cancelled); NONE with the band then
+        # overscan 0 set at once: the band's request is gone before it starts (SETTLE), and
+        # NONE without band needs none; PEELED without band then with 32 px: one, for 32 px.
+        self.assertEqual([r["helper_renders"] for r in report], [2, 2, 3], report)
         means = [r["ao_mean"] for r in report]
         self.assertLess(means[0], 0.97)
         self.assertGreater(abs(means[1] - means[0]), 1e-4, report)

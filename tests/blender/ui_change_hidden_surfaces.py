@@ -1,14 +1,17 @@
 # SPDX-License-Identifier: MIT
 """In Blender's UI: F12, then changes the SSAO node's hidden_surfaces and overscan as a user
-would (the node's update callback recomputes; the helper render of hidden_surfaces.py runs
-there, on the main thread), and writes what happened to a JSON report, then quits. Run under
-Xvfb by tests/blender/test_addon.py:
+would (the node's update callback recomputes; the helper render it needs runs in a Blender
+process of its own, helper_process.py, or, with --in-process, in this one), and writes what
+happened to a JSON report, then quits. Run under Xvfb by tests/blender/test_addon.py:
 
     xvfb-run -a blender --factory-startup -noaudio --addons ssao_compositor SCENE.blend \
-        --python tests/blender/ui_change_hidden_surfaces.py -- REPORT.json
+        --python tests/blender/ui_change_hidden_surfaces.py -- REPORT.json [--in-process]
+
+With helper processes, F12 is pressed a second time while the first F12's helper process
+renders: a new render cancels it (its exit status is reported).
 
 The report: for each step (after F12, then each change) the node's status, its AO image's
-mean, and how many helper renders ran so far."""
+mean, and how many helper renders ran so far (in this process and in helper processes)."""
 import json
 import sys
 import time
@@ -16,11 +19,12 @@ import traceback
 
 import bpy
 
-REPORT = sys.argv[sys.argv.index("--") + 1]
+ARGS = sys.argv[sys.argv.index("--") + 1:]
+REPORT = ARGS[0]
 START = time.monotonic()
 TIMEOUT = 180.0
 STEPS = [("after F12", None), ("NONE, 0", ('NONE', 0)), ("PEELED, 32", ('PEELED', 32))]
-STATE = {"step": -1, "idle_since": None, "report": [], "helper_renders": 0}
+STATE = {"step": -1, "idle_since": None, "report": [], "helper_renders": 0, "stale": None}
 
 
 def addon_module(name):
@@ -53,7 +57,14 @@ def finish(code):
 def busy():
     handlers = addon_module("handlers")
     return bpy.app.is_job_running('RENDER') or bool(handlers._pending_frames or
-                                                    handlers._written_frames)
+                                                    handlers._written_frames) or \
+        addon_module("helper_process").busy()
+
+
+def f12():
+    window = bpy.context.window_manager.windows[0]
+    with bpy.context.temp_override(window=window):
+        bpy.ops.render.render('INVOKE_DEFAULT')
 
 
 def step():
@@ -61,10 +72,16 @@ def step():
         if time.monotonic() - START > TIMEOUT:
             finish(1)
         if STATE["step"] < 0:
-            window = bpy.context.window_manager.windows[0]
-            with bpy.context.temp_override(window=window):
-                bpy.ops.render.render('INVOKE_DEFAULT')
+            f12()
             STATE["step"] = 0
+            return 1.0
+        helper_process = addon_module("helper_process")
+        if STATE["step"] == 0 and helper_process.enabled and STATE["stale"] is None:
+            # F12 again while the first F12's helper process renders: it must be cancelled.
+            if not helper_process._renders:
+                return 0.05
+            STATE["stale"] = next(iter(helper_process._renders.values())).process
+            f12()
             return 1.0
         if busy() or not node().status:
             return 0.5
@@ -74,7 +91,10 @@ def step():
         n = node()
         STATE["report"].append({"step": STEPS[STATE["step"]][0], "status": n.status,
                                 "ao_mean": ao_mean(n),
-                                "helper_renders": STATE["helper_renders"]})
+                                "helper_renders": STATE["helper_renders"] +
+                                helper_process.renders_started})
+        if STATE["stale"] is not None:
+            STATE["report"][-1]["stale_helper_exit"] = STATE["stale"].poll()
         STATE["step"] += 1
         STATE["idle_since"] = None
         if STATE["step"] == len(STEPS):
@@ -90,5 +110,6 @@ def step():
     return None
 
 
+addon_module("helper_process").enabled = "--in-process" not in ARGS
 bpy.app.handlers.render_pre.append(count_helper_renders)
 bpy.app.timers.register(step, first_interval=2.0)

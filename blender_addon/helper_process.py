@@ -1,0 +1,273 @@
+# SPDX-License-Identifier: MIT
+"""The hidden-surface helper render (hidden_surfaces.py) in a Blender process of its own, so that
+Blender's UI keeps responding while it renders: in the UI's own process the render stops the UI
+for as long as it takes, Cycles' scene synchronisation and BVH build included (1.4 s with 2 M
+triangles at 640x360, measured: docs/blender.md, "A responsive UI").
+
+The scene is written to a .blend of its own (bpy.data.libraries.write: the scene and every
+data-block it uses, paths made absolute; 50-90 ms for 135 MB, measured), and a background
+Blender (the same executable, `-b --factory-startup`) opens it and runs the same
+hidden_surfaces.render_layers, with the camera placed as the UI's is, and saves the layers as a
+.npz, which a thread reads back. What the helper adds to materials and objects for its render is
+added in that copy: the user's file is not touched. It costs Blender's start-up (0.8-0.9 s) and
+a second copy of the scene in memory while it runs (the add-on's preference turns it off).
+
+In the UI the add-on asks (layers_or_request()) rather than renders; the main-thread timer
+(poll()) starts a render for a request at once, or, when it replaced an earlier request of the
+same node, once it has not changed for SETTLE seconds (dragging the band's slider starts none
+until it stops); it cancels the renders no request wants any more, and hands the finished
+layers to hidden_surfaces' cache. A new render of the scene cancels its helpers
+(cancel()): their layers would be of the render before."""
+import atexit
+import json
+import os
+import shutil
+import subprocess
+import tempfile
+import threading
+import time
+
+import bpy
+import numpy as np
+
+from . import hidden_surfaces
+
+SETTLE = 0.25  # seconds a request that replaced another stays unchanged before it starts
+LOG_TAIL = 12  # lines of a failed helper's output quoted in the error
+
+enabled = True  # set by preferences.py: False renders in Blender's own process, as headless
+renders_started = 0  # helper processes started in this session (tests count them)
+
+_lock = threading.Lock()  # cancel() runs in the render thread (render_pre in the UI)
+_requests = {}  # (scene name, requester) -> _Request
+_renders = {}   # (scene name, key) -> _Render
+_failed = {}    # (scene name, key) -> error message, until the scene renders again
+
+# Run by the helper process, after Blender opened the scene's copy.
+_CHILD = r"""
+import importlib, json, os, sys
+import bpy
+import numpy as np
+args = json.loads(sys.argv[sys.argv.index("--") + 1])
+try:
+    sys.path.insert(0, args["addon_parent"])
+    hidden_surfaces = importlib.import_module(args["package"] + ".hidden_surfaces")
+    scene = bpy.data.scenes[args["scene"]]
+    scene.frame_set(args["frame"], subframe=args["subframe"])
+    layers = hidden_surfaces.render_layers(scene, args["hits"], args["overscan"],
+                                           folder=args["folder"],
+                                           camera_matrix=args["camera_matrix"])
+    part = args["output"] + ".part.npz"
+    np.savez(part, **layers)
+    os.replace(part, args["output"])
+except Exception as error:
+    with open(args["output"] + ".error", "w") as f:
+        f.write(str(error) or type(error).__name__)
+    raise
+"""
+
+
+class _Request:
+    def __init__(self, key, hits, overscan, replacing):
+        self.key, self.hits, self.overscan = key, hits, overscan
+        # A first request is due at once; one that replaces another (a slider being dragged)
+        # once it has not changed for SETTLE seconds.
+        self.due = time.monotonic() + (SETTLE if replacing else 0.0)
+
+
+class _Render:
+    """A helper process rendering one scene's layers; poll() until it gives them."""
+
+    def __init__(self, scene, hits, overscan):
+        self.folder = tempfile.mkdtemp(prefix="ssao_helper_", dir=bpy.app.tempdir or None)
+        self.process = self.loader = None
+        self.layers = self.error = None
+        try:
+            self._start(scene, hits, overscan)
+        except BaseException:
+            self.cancel()
+            raise
+
+    def _start(self, scene, hits, overscan):
+        global renders_started
+        blend = os.path.join(self.folder, "scene.blend")
+        bpy.data.libraries.write(blend, {scene}, path_remap='ABSOLUTE', compress=False)
+        self.output = os.path.join(self.folder, "layers.npz")
+        package = __package__.rpartition(".")[2]  # the folder's name, as a top-level package
+        addon = os.path.dirname(os.path.abspath(__file__))
+        camera = scene.camera
+        args = {"addon_parent": os.path.dirname(addon), "package": package,
+                "scene": scene.name, "frame": scene.frame_current,
+                "subframe": scene.frame_subframe, "hits": hits, "overscan": overscan,
+                "camera_matrix": camera and [list(row) for row in camera.matrix_world],
+                "folder": self.folder, "output": self.output}
+        # Drivers and other Python in the file run in the copy only where the user lets them.
+        autoexec = "-y" if bpy.context.preferences.filepaths.use_scripts_auto_execute \
+            else "-Y"
+        command = [bpy.app.binary_path, "-b", "--factory-startup", "-noaudio", autoexec, blend,
+                   "--python-exit-code", "3", "--python-expr", _CHILD, "--", json.dumps(args)]
+        self.log = os.path.join(self.folder, "helper.log")
+        with open(self.log, "w") as log:
+            self.process = subprocess.Popen(
+                command, stdin=subprocess.DEVNULL, stdout=log, stderr=subprocess.STDOUT,
+                cwd=self.folder, creationflags=getattr(subprocess, "CREATE_NO_WINDOW", 0))
+        renders_started += 1
+
+    def poll(self):
+        """False while it runs; True when self.layers or self.error is set."""
+        if self.loader is None:
+            # The layers are read as soon as they are written (freeing a big scene makes the
+            # process end a few tenths of a second later).
+            ended = self.process.poll() is not None  # before looking for the file
+            if not os.path.isfile(self.output):
+                if not ended:
+                    return False
+                self.error = f"the helper render failed: {self._why()}"
+                self.cancel()
+                return True
+            # A 4K frame's layers are hundreds of MB: read outside the main thread.
+            self.loader = threading.Thread(target=self._load, daemon=True)
+            self.loader.start()
+            return False
+        return not self.loader.is_alive()
+
+    def _load(self):
+        try:
+            with np.load(self.output) as stored:
+                self.layers = {name: stored[name] for name in stored.files}
+        except Exception as error:
+            self.error = f"reading the helper render's layers failed: {error}"
+        finally:
+            shutil.rmtree(self.folder, ignore_errors=True)
+
+    def _why(self):
+        """The child's error, or the end of its output (it crashed)."""
+        try:
+            with open(self.output + ".error", errors="replace") as f:
+                return f.read()
+        except OSError:
+            pass
+        try:
+            with open(self.log, errors="replace") as f:
+                lines = [line.rstrip() for line in f if line.strip()]
+        except OSError:
+            lines = []
+        return (f"Blender exit status {self.process.returncode}: " +
+                (" | ".join(lines[-LOG_TAIL:]) or "no output"))
+
+    def cancel(self):
+        """Stops the process (if it runs) and removes its files."""
+        if self.process is not None and self.process.poll() is None:
+            self.process.kill()
+            try:
+                self.process.wait(timeout=10)
+            except subprocess.TimeoutExpired:
+                pass
+        if self.loader is None:  # else the loader removes them when it has read them
+            shutil.rmtree(self.folder, ignore_errors=True)
+
+
+def layers_or_request(scene, hits, overscan, requester):
+    """The layers of `scene` (hidden_surfaces.render_layers') if they are kept; else None, and
+    `requester` (a node's name) asks for them, replacing what it asked for before. Raises the
+    error of a helper render that failed for the same layers since the scene last rendered."""
+    hidden_surfaces.check_request(hits, overscan)
+    key = hidden_surfaces.layers_key(scene, hits, overscan)
+    layers = hidden_surfaces.kept_layers(scene.name, key)
+    if layers is not None:
+        return layers
+    with _lock:
+        error = _failed.get((scene.name, key))
+        if error is not None:
+            raise RuntimeError(error)
+        asked = _requests.get((scene.name, requester))
+        if asked is None or asked.key != key:
+            _requests[(scene.name, requester)] = _Request(key, hits, overscan,
+                                                          replacing=asked is not None)
+    return None
+
+
+def withdraw(scene_name, requester):
+    """`requester` needs no layers any more (its settings changed)."""
+    with _lock:
+        _requests.pop((scene_name, requester), None)
+
+
+def waiting(scene_name, requester):
+    """Whether `requester` waits for layers of scene `scene_name`."""
+    return (scene_name, requester) in _requests
+
+
+def busy():
+    return bool(_requests or _renders)
+
+
+def poll():
+    """Main thread, from the add-on's timer: starts the requests that are due (one render for
+    the nodes that ask for the same layers), cancels the renders no request wants, collects the
+    finished ones. Returns {scene name: frame} of the scenes whose requests were answered
+    (layers kept, an error recorded, or dropped: the scene changed): compute them again."""
+    answered = {}
+    rendering = bpy.app.is_job_running('RENDER')  # a new render cancels these anyway
+    with _lock:
+        wanted = {(scene, request.key) for (scene, _), request in _requests.items()}
+        for id_ in [i for i in _renders if i not in wanted]:
+            _renders.pop(id_).cancel()
+        now = time.monotonic()
+        due = {(scene, request.key): request for (scene, _), request in _requests.items()
+               if now >= request.due and (scene, request.key) not in _renders}
+    for (scene_name, _), request in due.items() if not rendering else ():
+        scene = bpy.data.scenes.get(scene_name)
+        if scene is None or hidden_surfaces.layers_key(
+                scene, request.hits, request.overscan) != request.key:
+            # The frame or the camera changed since: computed again, it asks again (or says
+            # the frame changed).
+            _drop_requests(scene_name, request.key)
+            answered[scene_name] = request.key[0]
+            continue
+        try:
+            render = _Render(scene, request.hits, request.overscan)
+        except Exception as error:
+            _answer(scene_name, request.key, error=f"starting the helper render failed: {error}")
+            answered[scene_name] = request.key[0]
+            continue
+        with _lock:
+            _renders[(scene_name, request.key)] = render
+    with _lock:
+        running = list(_renders.items())
+    for (scene_name, key), render in running:
+        if render.poll():
+            with _lock:
+                _renders.pop((scene_name, key), None)
+            _answer(scene_name, key, render.layers, render.error)
+            answered[scene_name] = key[0]
+    return answered
+
+
+def _answer(scene_name, key, layers=None, error=None):
+    if layers is not None:
+        hidden_surfaces.keep(scene_name, key, layers)
+    else:
+        with _lock:
+            _failed[(scene_name, key)] = error
+    _drop_requests(scene_name, key)
+
+
+def _drop_requests(scene_name, key):
+    with _lock:
+        for id_ in [i for i, r in _requests.items() if i[0] == scene_name and r.key == key]:
+            del _requests[id_]
+
+
+def cancel(scene_name=None):
+    """Forgets the requests, renders and failures of `scene_name` (every scene with None): it
+    renders again. Safe from any thread."""
+    with _lock:
+        for table in (_requests, _renders, _failed):
+            for id_ in [i for i in table if scene_name is None or i[0] == scene_name]:
+                item = table.pop(id_)
+                if table is _renders:
+                    item.cancel()
+
+
+atexit.register(cancel)  # no helper outlives Blender

@@ -1,0 +1,108 @@
+# SPDX-License-Identifier: MIT
+"""Checks the add-on's helper render in a process of its own (blender_addon/helper_process.py)
+on the open .blend, in background Blender (the UI polls it from a timer; here a loop does):
+  - "equal": the layers it renders, for each array, equal to hidden_surfaces.render_layers'
+    in this process (the same Cycles, settings and camera: bit for bit);
+  - "settled": a request replaced before it settles starts no process (only the last one);
+  - "cancelled": cancel() kills a running helper process and removes its files;
+  - "failure": a helper that fails (a scene without a camera) gives its error, with the
+    child's own message, until the scene renders again (cancel()).
+Writes --out JSON with those results.
+
+    blender -b --factory-startup --addons ssao_compositor SCENE.blend \\
+        -P tests/blender/check_helper_process.py -- --out RESULT.json
+"""
+import argparse
+import importlib
+import json
+import os
+import sys
+import time
+
+import bpy
+import numpy as np
+
+TIMEOUT = 120.0
+
+
+def addon_module(name):
+    package = next(n for n in sys.modules if n.endswith("ssao_compositor"))
+    return importlib.import_module(f"{package}.{name}")
+
+
+helper_process = addon_module("helper_process")
+hidden_surfaces = addon_module("hidden_surfaces")
+
+
+def poll_until(condition):
+    start = time.monotonic()
+    while True:
+        answered = helper_process.poll()
+        if condition(answered):
+            return answered
+        if time.monotonic() - start > TIMEOUT:
+            raise TimeoutError("the helper process did not answer")
+        time.sleep(0.05)
+
+
+def main():
+    argv = sys.argv[sys.argv.index("--") + 1:]
+    parser = argparse.ArgumentParser()
+    parser.add_argument("--out", required=True)
+    args = parser.parse_args(argv)
+    scene = bpy.context.scene
+    hits, overscan = 3, 16
+    result = {}
+
+    # A request replaced before it settles: only the second starts a process.
+    started = helper_process.renders_started
+    assert helper_process.layers_or_request(scene, hits, 8, "node") is None
+    assert helper_process.layers_or_request(scene, hits, overscan, "node") is None
+    start = time.monotonic()
+    answered = poll_until(bool)
+    result["seconds"] = time.monotonic() - start
+    result["settled"] = {"processes": helper_process.renders_started - started,
+                         "answered": answered}
+    background = helper_process.layers_or_request(scene, hits, overscan, "node")
+    hidden_surfaces.forget()
+    start = time.monotonic()
+    here = hidden_surfaces.render_layers(scene, hits, overscan)
+    result["in_process_seconds"] = time.monotonic() - start
+    result["equal"] = {name: bool(background is not None and name in background and
+                                  background[name].dtype == array.dtype and
+                                  np.array_equal(background[name], array))
+                       for name, array in here.items()}
+    result["geometry_pixels"] = int((here["depth"] < hidden_surfaces.BACKGROUND).sum())
+
+    # Cancelled while it runs.
+    hidden_surfaces.forget()
+    assert helper_process.layers_or_request(scene, hits, overscan, "node") is None
+    poll_until(lambda _: helper_process._renders)
+    render = next(iter(helper_process._renders.values()))
+    helper_process.cancel(scene.name)
+    result["cancelled"] = {"exit": render.process.poll(),
+                           "files_left": os.path.exists(render.folder),
+                           "busy": helper_process.busy()}
+
+    # A helper that fails: its error, with the child's message, until the scene renders again.
+    camera, scene.camera = scene.camera, None
+    assert helper_process.layers_or_request(scene, hits, overscan, "node") is None
+    poll_until(bool)
+    try:
+        helper_process.layers_or_request(scene, hits, overscan, "node")
+        result["failure"] = "no error"
+    except RuntimeError as error:
+        result["failure"] = str(error)
+    helper_process.cancel(scene.name)
+    result["after_failure_asks_again"] = \
+        helper_process.layers_or_request(scene, hits, overscan, "node") is None
+    helper_process.cancel(scene.name)
+    scene.camera = camera
+
+    with open(args.out, "w") as f:
+        json.dump(result, f, indent=1)
+    print(f"[measure] helper process: layers in {result['seconds']:.2f} s (in this process "
+          f"{result['in_process_seconds']:.2f} s), equal: {result['equal']}", flush=True)
+
+
+main()
