@@ -4,6 +4,8 @@
 #include <cmath>
 #include <numeric>
 
+#include "portable_math.h"
+
 namespace ssao {
 namespace {
 
@@ -38,7 +40,8 @@ Kernel make_hemisphere_kernel(int samples) {
     const float disk_radius = std::sqrt((float(k) + 0.5f) / float(samples));
     const float angle = float(k) * kGoldenAngle;
     const float z = std::sqrt(std::max(0.0f, 1.0f - disk_radius * disk_radius));
-    kernel.directions.push_back({disk_radius * std::cos(angle), disk_radius * std::sin(angle), z});
+    kernel.directions.push_back(
+        {disk_radius * portable_cos(angle), disk_radius * portable_sin(angle), z});
     kernel.stratum.push_back(int((long(k) * step) % samples));
   }
   return kernel;
@@ -53,7 +56,7 @@ Kernel make_sphere_kernel(int samples) {
     const float z = (float(k) + 0.5f) / float(pairs);
     const float ring = std::sqrt(std::max(0.0f, 1.0f - z * z));
     const float angle = float(k) * kGoldenAngle;
-    const Vec3 d{ring * std::cos(angle), ring * std::sin(angle), z};
+    const Vec3 d{ring * portable_cos(angle), ring * portable_sin(angle), z};
     const int stratum = int((long(k) * step) % pairs);
     kernel.directions.push_back(d);
     kernel.stratum.push_back(stratum);
@@ -64,7 +67,7 @@ Kernel make_sphere_kernel(int samples) {
 }
 
 float radial_scale(float s, float clustering) {
-  const float shaped = clustering == 0.0f ? 1.0f : std::pow(s, clustering);
+  const float shaped = clustering == 0.0f ? 1.0f : portable_pow(s, clustering);
   return 0.1f + 0.9f * shaped;
 }
 
@@ -79,7 +82,8 @@ std::array<JitterState, kJitterStates> jitter_states(uint32_t seed) {
     const int radial_index = (index * 7 + 3) & 15;
     float radial = (float(radial_index) + radial_seed) / float(kJitterStates);
     if (radial >= 1.0f) radial -= 1.0f;
-    states[index] = {angle, std::cos(2.0f * kPi * angle), std::sin(2.0f * kPi * angle), radial};
+    states[index] = {angle, portable_cos(2.0f * kPi * angle), portable_sin(2.0f * kPi * angle),
+                     radial};
   }
   return states;
 }

@@ -7,7 +7,9 @@
 // 640x360 run (getrusage, docs/architecture.md "Cold start").
 #pragma once
 
+#if SSAO_THREADS_TBB
 #include <tbb/scalable_allocator.h>
+#endif
 
 #include <memory>
 #include <vector>
@@ -23,8 +25,11 @@ namespace ssao {
 #define SSAO_SCRATCH_ALLOCATOR(T) std::allocator<T>
 #endif
 #endif
-#ifndef SSAO_SCRATCH_ALLOCATOR
+#if !defined(SSAO_SCRATCH_ALLOCATOR) && SSAO_THREADS_TBB
 #define SSAO_SCRATCH_ALLOCATOR(T) tbb::scalable_allocator<T>
+#endif
+#ifndef SSAO_SCRATCH_ALLOCATOR  // the std::thread build (tiles.cpp): no oneTBB
+#define SSAO_SCRATCH_ALLOCATOR(T) std::allocator<T>
 #endif
 
 template <class T>

@@ -1,9 +1,19 @@
 // SPDX-License-Identifier: MIT
 #include "tiles.h"
 
+// The tiles run on oneTBB (SSAO_THREADS_TBB, the Linux build: the pool Blender and OpenImageIO
+// share) or on std::thread (where no oneTBB is built for the target: the Windows DLL). Either
+// way each tile is computed by one thread into its own pixels: the same bits.
+#if SSAO_THREADS_TBB
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
+#else
+#include <exception>
+#include <mutex>
+#include <system_error>
+#include <vector>
+#endif
 
 #include <algorithm>
 #include <atomic>
@@ -53,10 +63,66 @@ int resolve_thread_count(int requested) {
   return hw == 0 ? 1 : static_cast<int>(hw);
 }
 
+#if SSAO_THREADS_TBB
 struct TilePool::Arena {
   explicit Arena(int threads) : arena(threads) {}
+  // body(i) for every i in [0, count), on the arena's threads (the caller's among them).
+  void parallel(int count, const std::function<void(int)>& body) {
+    // Only ThreadSanitizer reads these (see SSAO_TSAN_RELEASE above).
+    char before_tiles = 0, after_tiles = 0;
+    SSAO_TSAN_RELEASE(&before_tiles);
+    arena.execute([&] {
+      tbb::parallel_for(
+          tbb::blocked_range<int>(0, count, 1),
+          [&](const tbb::blocked_range<int>& r) {
+            SSAO_TSAN_ACQUIRE(&before_tiles);
+            for (int i = r.begin(); i != r.end(); ++i) body(i);
+            SSAO_TSAN_RELEASE(&after_tiles);
+          },
+          tbb::simple_partitioner());
+    });
+    SSAO_TSAN_ACQUIRE(&after_tiles);
+  }
   tbb::task_arena arena;
 };
+#else
+struct TilePool::Arena {
+  explicit Arena(int thread_count) : threads(thread_count) {}
+  // body(i) for every i in [0, count), on the caller's thread and threads - 1 others started for
+  // the run (a few tens of microseconds each, against milliseconds of tiles). The first
+  // exception stops the handing out of indices and is rethrown here, as tbb::parallel_for does.
+  void parallel(int count, const std::function<void(int)>& body) {
+    std::atomic<int> next{0};
+    std::exception_ptr error;
+    std::mutex error_mutex;
+    auto work = [&] {
+      for (int i = next.fetch_add(1); i < count; i = next.fetch_add(1)) {
+        try {
+          body(i);
+        } catch (...) {
+          const std::lock_guard<std::mutex> lock(error_mutex);
+          if (!error) error = std::current_exception();
+          next.store(count);
+        }
+      }
+    };
+    std::vector<std::thread> others;
+    const int wanted = std::min(threads, count) - 1;
+    others.reserve(static_cast<size_t>(std::max(wanted, 0)));
+    for (int t = 0; t < wanted; ++t) {
+      try {
+        others.emplace_back(work);
+      } catch (const std::system_error&) {
+        break;  // no more threads to be had: the ones started (and the caller) do the rest
+      }
+    }
+    work();
+    for (std::thread& other : others) other.join();
+    if (error) std::rethrow_exception(error);
+  }
+  int threads;
+};
+#endif
 
 TilePool::TilePool(int threads)
     : threads_(resolve_thread_count(threads)), arena_(std::make_unique<Arena>(threads_)) {}
@@ -96,20 +162,7 @@ void TilePool::run(int width, int height, int tile_width, int tile_height, Progr
       stop = true;
     }
   };
-  // Only ThreadSanitizer reads these (see SSAO_TSAN_RELEASE above).
-  char before_tiles = 0, after_tiles = 0;
-  SSAO_TSAN_RELEASE(&before_tiles);
-  arena_->arena.execute([&] {
-    tbb::parallel_for(
-        tbb::blocked_range<int>(0, count, 1),
-        [&](const tbb::blocked_range<int>& r) {
-          SSAO_TSAN_ACQUIRE(&before_tiles);
-          for (int i = r.begin(); i != r.end(); ++i) one_tile(i);
-          SSAO_TSAN_RELEASE(&after_tiles);
-        },
-        tbb::simple_partitioner());
-  });
-  SSAO_TSAN_ACQUIRE(&after_tiles);
+  arena_->parallel(count, one_tile);
   progress.throw_if_cancelled();
   progress.report(1.0);
   progress.throw_if_cancelled();

@@ -1,7 +1,8 @@
 // SPDX-License-Identifier: MIT
-// Image tiles on a persistent oneTBB arena. Every tile is computed by exactly one thread and
-// written to its own pixels only, so results never depend on the thread count, the tiling or the
-// scheduling. Progress is reported, and cancellation asked, on the calling thread only.
+// Image tiles on a persistent oneTBB arena, or on std::threads where the library is built
+// without oneTBB (tiles.cpp). Every tile is computed by exactly one thread and written to its own
+// pixels only, so results never depend on the thread count, the tiling or the scheduling.
+// Progress is reported, and cancellation asked, on the calling thread only.
 #pragma once
 
 #include <functional>

@@ -19,6 +19,7 @@
 #include <array>
 #include <cmath>
 
+#include "portable_math.h"
 #include "sampling.h"
 #include "variant.h"
 
@@ -81,7 +82,7 @@ class Horizon final : public Variant {
     for (int j = 0; j < kJitterStates; ++j) {
       for (int s = 0; s < slices_; ++s) {
         const float angle = kPi * (float(s) + states[j].angle) / float(slices_);
-        lines_[size_t(j) * slices_ + s] = {std::cos(angle), std::sin(angle)};
+        lines_[size_t(j) * slices_ + s] = {portable_cos(angle), portable_sin(angle)};
       }
       for (int k = 0; k < steps_; ++k) {
         const float f = (float(k) + states[j].radial_offset) / float(steps_);
@@ -173,7 +174,7 @@ class Horizon final : public Variant {
           occluded |= sector_mask(beta_front, fast_atan2(dot(back, e_t), dot(back, e_n)));
         }
       }
-      const float total = cos_gamma + std::atan2(sin_gamma, cos_gamma) * sin_gamma;
+      const float total = cos_gamma + portable_atan2(sin_gamma, cos_gamma) * sin_gamma;
       const float blocked = occluded_measure(occluded, cos_gamma, sin_gamma);
       visible_sum += projected_length * (total - blocked);
       total_sum += projected_length * total;
@@ -252,7 +253,7 @@ class Horizon final : public Variant {
   // form, with the sign of sin(beta + gamma) flipping at beta = -gamma.
   float occluded_measure(uint32_t bits, float cos_gamma, float sin_gamma) const {
     if (bits == 0) return 0.0f;
-    const float gamma = std::atan2(sin_gamma, cos_gamma);
+    const float gamma = portable_atan2(sin_gamma, cos_gamma);
     const float split_beta = -gamma;
     const float split_value = -0.25f * cos_gamma - 0.5f * gamma * sin_gamma;
     const float sector = kPi / float(kSectors);

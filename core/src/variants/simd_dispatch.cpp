@@ -6,6 +6,8 @@
 #endif
 
 #include <cstdint>
+#include <cstdlib>
+#include <cstring>
 
 namespace ssao {
 namespace {
@@ -48,8 +50,23 @@ SimdTarget detect() { return SimdTarget::baseline; }
 
 }  // namespace
 
+// $SSAO_SIMD_TARGET (avx3, avx2, sse4, ssse3 or baseline) narrows the choice: the kernels of
+// a wider target sum their lanes in another order, so the last bits of the AO follow the CPU.
+// Machines that must agree bit for bit (a farm of mixed CPUs; the Linux and the Windows build
+// compared in tests/windows) name the same target. A target the CPU lacks, or an unknown name,
+// is ignored.
+static SimdTarget narrowed(SimdTarget cpu) {
+  const char* wanted = std::getenv("SSAO_SIMD_TARGET");
+  if (wanted == nullptr) return cpu;
+  const char* names[] = {"avx3", "avx2", "sse4", "ssse3", "baseline"};
+  for (int t = 0; t <= int(SimdTarget::baseline); ++t) {
+    if (std::strcmp(wanted, names[t]) == 0) return t >= int(cpu) ? SimdTarget(t) : cpu;
+  }
+  return cpu;
+}
+
 SimdTarget cpu_simd_target() {
-  static const SimdTarget target = detect();
+  static const SimdTarget target = narrowed(detect());
   return target;
 }
 

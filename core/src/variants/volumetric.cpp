@@ -232,6 +232,7 @@ HWY_AFTER_NAMESPACE();
 #include <cmath>
 #include <vector>
 
+#include "portable_math.h"
 #include "variant.h"
 #include "variants/simd_dispatch.h"
 
@@ -263,7 +264,7 @@ class Volumetric final : public Variant {
       for (int k = 0; k < pairs_; ++k) {
         const float r = std::sqrt((float(k) + js.radial_offset) / float(pairs_));
         const float a = float(k) * golden_angle + 2.0f * float(M_PI) * js.angle;
-        const DiskPoint point{r * std::cos(a), r * std::sin(a)};
+        const DiskPoint point{r * portable_cos(a), r * portable_sin(a)};
         disk_[(size_t(j) * pairs_ + k) * 2] = point;
         disk_[(size_t(j) * pairs_ + k) * 2 + 1] = {-point.x, -point.y};
       }
