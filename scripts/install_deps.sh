@@ -7,6 +7,8 @@ PACKAGES=(
   g++ cmake ninja-build pkg-config clang-format   # build, style check
   clang-14 libfuzzer-14-dev libclang-rt-14-dev    # fuzzing (scripts/fuzz.sh: libFuzzer, sanitizers)
   libgtest-dev                              # unit tests
+  g++-mingw-w64-x86-64-posix googletest     # the Windows DLL (scripts/build_windows.sh)
+  wine wine64                               # its tests, run under Wine
   libtbb-dev                                # the library's thread pool (oneTBB)
   libhwy-dev                                # the library's SIMD kernels (Highway)
   libopenimageio-dev openimageio-tools      # EXR I/O of the command-line tool

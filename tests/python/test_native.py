@@ -2,7 +2,7 @@
 # SPDX-License-Identifier: MIT
 """The ctypes binding (core/python/ssao/_binding.py) against the built library, without Blender.
 
-    /usr/bin/python3 tests/python/test_native.py LIBRARY
+    /usr/bin/python3 tests/python/test_native.py LIBRARY [WINDOWS_DLL]
 """
 import os
 import sys
@@ -15,6 +15,7 @@ sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."
 import ssao  # noqa: E402
 
 LIBRARY = None
+WINDOWS_DLL = None
 
 
 def corner_scene(width=64, height=48):
@@ -126,6 +127,37 @@ class NativeBindingTest(unittest.TestCase):
                 job.run()
 
 
+class LibraryFileTest(unittest.TestCase):
+    """Which file the binding loads on each platform (the add-on bundles lib/libssao.so and
+    lib/ssao.dll), and what a library it cannot load gives: an SSAOError naming the file and the
+    loader's reason, never a crash."""
+
+    def candidates(self, platform):
+        saved = sys.platform
+        sys.platform = platform
+        try:
+            return list(ssao._binding._candidate_paths())
+        finally:
+            sys.platform = saved
+
+    def test_each_platform_looks_for_its_own_file_in_the_bundled_lib_folder(self):
+        bundled = os.path.normpath(os.path.join(os.path.dirname(ssao._binding.__file__), "..",
+                                                "lib"))
+        for platform, name in (("linux", "libssao.so"), ("win32", "ssao.dll"),
+                               ("darwin", "libssao.dylib")):
+            self.assertEqual(self.candidates(platform)[0], os.path.join(bundled, name), platform)
+
+    def test_a_library_of_another_platform_is_an_error_not_a_crash(self):
+        # The real ssao.dll on Linux stands for any library the loader refuses (the wrong
+        # platform, a damaged file): the error names it and says why.
+        if WINDOWS_DLL is None:
+            self.skipTest("no Windows DLL given (build/windows/bin/ssao.dll)")
+        with self.assertRaisesRegex(ssao.SSAOError, r"cannot load libssao .*ssao\.dll: .*"
+                                                    r"invalid ELF header"):
+            ssao.load_library(WINDOWS_DLL)
+
+
 if __name__ == "__main__":
     LIBRARY = sys.argv.pop(1) if len(sys.argv) > 1 else None
+    WINDOWS_DLL = sys.argv.pop(1) if len(sys.argv) > 1 else None
     unittest.main()
