@@ -21,6 +21,7 @@ import subprocess
 import sys
 import tempfile
 import unittest
+import zipfile
 
 import numpy as np
 
@@ -1013,6 +1014,36 @@ class MissingLibraryTest(unittest.TestCase):
             blend = blender.build_scene("scene", "--output", os.path.join(root, "out_####.png"))
             log = blender.run(blend, "-f", "1")
             self.assertIn("ssao_compositor: error: libssao not found", log)
+            self.assertTrue(os.path.exists(os.path.join(root, "out_0001.png")))
+        finally:
+            shutil.rmtree(root, ignore_errors=True)
+
+    def test_a_library_it_cannot_load_is_reported(self):
+        # The zip carries ssao.dll for Windows beside libssao.so (when the build cross-built
+        # it: then the manifest lists both platforms). A library the loader refuses (here the
+        # Windows DLL in place of libssao.so: the wrong platform, as a damaged file would be)
+        # is reported as the missing one is, with the loader's reason; Blender does not crash.
+        with zipfile.ZipFile(CONFIG["zip"]) as archive:
+            names = archive.namelist()
+            manifest = archive.read("ssao_compositor/blender_manifest.toml").decode()
+        if "ssao_compositor/lib/ssao.dll" not in names:
+            self.assertIn('platforms = ["linux-x64"]', manifest)
+            self.skipTest("this build did not cross-build ssao.dll (SSAO_WINDOWS)")
+        self.assertIn('platforms = ["linux-x64", "windows-x64"]', manifest)
+        root = tempfile.mkdtemp(prefix="ssao_badlib_", dir="/tmp")
+        try:
+            blender = Blender(root)
+            blender.install(CONFIG["zip"])
+            libraries = glob.glob(os.path.join(root, "**", "ssao_compositor", "lib", "*"),
+                                  recursive=True)
+            self.assertEqual(sorted(os.path.basename(p) for p in libraries),
+                             ["libssao.so", "ssao.dll"], libraries)
+            linux = next(p for p in libraries if p.endswith(".so"))
+            shutil.copyfile(next(p for p in libraries if p.endswith(".dll")), linux)
+            blend = blender.build_scene("scene", "--output", os.path.join(root, "out_####.png"))
+            log = blender.run(blend, "-f", "1")
+            self.assertRegex(log, r"ssao_compositor: error: libssao not found: \S*libssao\.so: "
+                                  r".*invalid ELF header")
             self.assertTrue(os.path.exists(os.path.join(root, "out_0001.png")))
         finally:
             shutil.rmtree(root, ignore_errors=True)
