@@ -38,6 +38,11 @@ fi
 # made on first use (a few seconds). No Mono or Gecko: the tests need neither.
 export WINEPREFIX=${WINEPREFIX:-$build/wineprefix} WINEDEBUG=-all WINEDLLOVERRIDES="mscoree,mshtml="
 
+if [[ $tests == ON && ! -f "$WINEPREFIX/system.reg" ]]; then
+  # Made once, before the build lists the tests with several Wine processes at a time.
+  mkdir -p "$build"
+  wineboot --init >/dev/null 2>&1 || { echo "build_windows: wineboot --init failed" >&2; exit 1; }
+fi
 cmake -S "$root" -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=Release \
   -DCMAKE_TOOLCHAIN_FILE="$root/scripts/mingw-w64-x86_64.cmake" \
   -DSSAO_BUILD_TOOLS=OFF -DSSAO_BUILD_BENCHMARKS=OFF -DSSAO_BUILD_TESTS=$tests >/dev/null
