@@ -88,17 +88,20 @@ void print_camera(const CameraReading& reading, bool scene_camera_for_frame, int
     std::printf("every pass is rendered with (after the scene):\n%s",
                 reading.camera.to_sdl().c_str());
   }
+  // What the library uses, read back from a job the camera was applied to.
   ssao::api::Job job;
   reading.camera.apply_to_job(job, width, height);
-  if (reading.camera.orthographic) {
-    std::printf("libssao (%dx%d): camera_type ORTHO, ortho_scale %.9g", width, height,
-                job.get_float("ortho_scale"));
+  const std::string type = job.get_string("camera_type");
+  const std::vector<double> k = job.get_floats("intrinsics", 4);
+  std::printf("libssao (%dx%d): camera_type %s, projection %s, fx %.9g fy %.9g cx %.9g cy %.9g",
+              width, height, type.c_str(), job.get_string("projection").c_str(), k[0], k[1], k[2],
+              k[3]);
+  if (type == "ORTHO") {
+    std::printf(" pixels per unit: %.9g units across\n", width / k[0]);
   } else {
-    std::printf("libssao (%dx%d): camera_type PERSP, lens %.9g mm, sensor_width 36 mm", width,
-                height, job.get_float("lens"));
+    std::printf(" pixels: a %.4g mm lens on a 36 mm sensor across the width\n",
+                36.0 * k[0] / width);
   }
-  std::printf(", sensor_fit HORIZONTAL, pixel_aspect %.9g:%.9g\n", job.get_float("pixel_aspect_x"),
-              job.get_float("pixel_aspect_y"));
 }
 
 }  // namespace povray_ssao

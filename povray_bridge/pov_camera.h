@@ -54,8 +54,8 @@ struct ResolvedCamera {
   // One line for the progress output.
   std::string summary() const;
 
-  // Sets camera_type, lens or ortho_scale, sensor_width 36, sensor_fit HORIZONTAL and the
-  // pixel aspect for a W x H image so that libssao's pixel <-> view mapping is POV-Ray's.
+  // Sets camera_type and the pinhole intrinsics (projection intrinsics: fx, fy, cx, cy) of a
+  // W x H image so that libssao's pixel <-> view mapping is POV-Ray's.
   void apply_to_job(ssao::api::Job& job, int width, int height) const;
 
   // radial distance / planar depth of pixel (px, py): 1 for orthographic cameras.

@@ -785,6 +785,26 @@ class GuardBandTest(PovTestCase):
         self.assertEqual(len(parse_camera_blocks(proc.stdout)), 1, self.detail(proc))
         self.assertIn("every pass is rendered with", proc.stdout)
 
+    def test_print_camera_shows_the_intrinsics_the_library_uses(self):
+        # A 60-degree camera at 640x480 (issue 35: the line showed the library's unset default,
+        # a 50 mm lens): fx = 320 / tan(30 deg) = 554.256 pixels, centre (320, 240), which is a
+        # 31.18 mm lens on a 36 mm sensor; fy = 554.256 x 1.33 / (4 / 3) = 552.871, POV-Ray's
+        # default right being 1.33 x, not 4/3. An orthographic camera 4 units wide: fx = 160
+        # pixels per unit.
+        for camera, expected in (("angle 60", "fx 554.256258 fy 552.870618 cx 320 cy 240 "
+                                               "pixels: a 31.18 mm lens"),
+                                 ("orthographic right x*4 up y*3",
+                                  "fx 160 fy 160 cx 320 cy 240 pixels per unit: 4 units")):
+            scene = self.copy_scene("camera.pov", "camera { %s location <0,1,-3> "
+                                    "look_at <0,0,0> }\n"
+                                    "sphere { 0, 1 pigment { rgb 1 } }\n" % camera)
+            proc = self.run_bridge(scene, "-o", self.path("x.png"), "+W640", "+H480",
+                                   "--print-camera")
+            self.assert_ok(proc)
+            line = next(l for l in proc.stdout.splitlines() if l.startswith("libssao (640x480)"))
+            self.assertIn("projection intrinsics", line, self.detail(proc))
+            self.assertIn(expected, line, self.detail(proc))
+
     def test_band_equals_a_larger_frame_cropped(self):
         # The default band against a run on the larger frame (W + 2G) x (H + 2G) without a band,
         # its horizontal angle widened to the same pixel grid, cropped: the same passes and the

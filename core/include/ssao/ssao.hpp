@@ -95,6 +95,12 @@ class Job {
     check_status(ssao_job_get_float(job_, name.c_str(), &value), "parameter " + name);
     return value;
   }
+  std::vector<double> get_floats(const std::string& name, size_t count) const {
+    std::vector<double> values(count);
+    check_status(ssao_job_get_floats(job_, name.c_str(), values.data(), count),
+                 "parameter " + name);
+    return values;
+  }
   std::string get_string(const std::string& name) const {
     char buffer[256] = {};
     check_status(ssao_job_get_string(job_, name.c_str(), buffer, sizeof buffer),
