@@ -1,23 +1,15 @@
 // SPDX-License-Identifier: MIT
-// Internal error type: core code throws it, api.cpp turns it into a status and a message.
+// The error core code throws: the public C++ wrapper's (a status and a message), which api.cpp
+// turns into the C API's status and ssao_last_error(). It never crosses the C API.
 #pragma once
 
-#include <stdexcept>
 #include <string>
 
-#include "ssao/ssao.h"
+#include "ssao/ssao.hpp"
 
 namespace ssao {
 
-class Error : public std::runtime_error {
- public:
-  Error(ssao_status status, const std::string& message)
-      : std::runtime_error(message), status_(status) {}
-  ssao_status status() const { return status_; }
-
- private:
-  ssao_status status_;
-};
+using Error = api::Error;
 
 [[noreturn]] inline void throw_invalid_argument(const std::string& message) {
   throw Error(SSAO_ERROR_INVALID_ARGUMENT, message);

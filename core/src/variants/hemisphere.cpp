@@ -23,13 +23,9 @@
 
 #include "camera.h"
 #include "sampling.h"
+#include "variants/lane_table.h"
 
 namespace ssao {
-// Up to 16 lanes (AVX-512 floats); the jitter pattern repeats every 4 pixels of a row, so a
-// table row of 16 + 3 lanes serves a vector starting at any x (read from lane x & 3).
-constexpr int kMaxLanes = 16;
-constexpr int kLaneTable = kMaxLanes + 3;
-
 struct HemisphereRowArgs {
   const float* depth;           // the frame's depth plane
   const uint32_t* normals;      // the frame's packed normals
@@ -404,16 +400,10 @@ class Hemisphere final : public Variant {
       }
     }
     // The same offsets laid out for the vector path: [y & 3][sample][x, y, z][lane].
-    lane_offsets_.resize(size_t(4) * samples * 3 * kLaneTable);
-    for (int row = 0; row < 4; ++row) {
-      for (int s = 0; s < samples; ++s) {
-        for (int lane = 0; lane < kLaneTable; ++lane) {
-          const Vec3 o = offsets_[size_t(jitter_index(lane, row)) * samples + s];
-          float* dst = lane_offsets_.data() + ((size_t(row) * samples + s) * 3) * kLaneTable + lane;
-          dst[0] = o.x, dst[kLaneTable] = o.y, dst[2 * kLaneTable] = o.z;
-        }
-      }
-    }
+    lane_offsets_ = lane_table<3>(samples, [&](int jitter, int s) {
+      const Vec3 o = offsets_[size_t(jitter) * samples + s];
+      return std::array<float, 3>{o.x, o.y, o.z};
+    });
   }
 
   void estimate(const Frame& f, const Tile& t, float* visibility) const override {

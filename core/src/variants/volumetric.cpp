@@ -27,15 +27,9 @@
 
 #include "camera.h"
 #include "sampling.h"
+#include "variants/lane_table.h"
 
 namespace ssao {
-namespace volumetric {
-// Up to 16 lanes (AVX-512 floats); the jitter pattern repeats every 4 pixels of a row, so a
-// table row of 16 + 3 lanes serves a vector starting at any x (read from lane x & 3).
-constexpr int kMaxLanes = 16;
-constexpr int kLaneTable = kMaxLanes + 3;
-}  // namespace volumetric
-
 struct DiskPoint {
   float x, y;  // on the unit disk
 };
@@ -58,8 +52,6 @@ HWY_BEFORE_NAMESPACE();
 namespace ssao {
 namespace HWY_NAMESPACE {
 namespace hn = hwy::HWY_NAMESPACE;
-using volumetric::kLaneTable;
-using volumetric::kMaxLanes;
 
 // Visibility of pixels [x0, x1) of row y into out[0 .. x1 - x0): Volumetric::pixel() on as many
 // pixels as a vector holds.
@@ -245,8 +237,6 @@ decltype(&HWY_STATIC_DISPATCH(volumetric_row)) best_volumetric_row() {
   return row;
 }
 
-using volumetric::kLaneTable;
-
 class Volumetric final : public Variant {
  public:
   explicit Volumetric(const ParamValues& v) {
@@ -270,16 +260,10 @@ class Volumetric final : public Variant {
       }
     }
     // The same points for the vector path: [y & 3][pair][x, y][lane] (the mirror is -point).
-    lane_disk_.resize(size_t(4) * pairs_ * 2 * kLaneTable);
-    for (int row = 0; row < 4; ++row) {
-      for (int k = 0; k < pairs_; ++k) {
-        for (int lane = 0; lane < kLaneTable; ++lane) {
-          const DiskPoint point = disk_[(size_t(jitter_index(lane, row)) * pairs_ + k) * 2];
-          float* dst = lane_disk_.data() + (size_t(row) * pairs_ + k) * 2 * kLaneTable + lane;
-          dst[0] = point.x, dst[kLaneTable] = point.y;
-        }
-      }
-    }
+    lane_disk_ = lane_table<2>(pairs_, [&](int jitter, int k) {
+      const DiskPoint point = disk_[(size_t(jitter) * pairs_ + k) * 2];
+      return std::array<float, 2>{point.x, point.y};
+    });
   }
 
   void estimate(const Frame& f, const Tile& t, float* visibility) const override {
