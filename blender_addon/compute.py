@@ -414,10 +414,13 @@ def _extra_layers(depth, layers, hits):
     return images
 
 
+WAITING_STATUS = "Rendering hidden surfaces for frame {frame}; the AO without them meanwhile"
+
+
 def waiting_status(node, scene, frame):
     """The node's status while helper_process renders the layers it asked for, else None."""
     if helper_process.waiting(scene.name, node.name):
-        return f"Rendering hidden surfaces for frame {frame}; the AO without them meanwhile"
+        return WAITING_STATUS.format(frame=frame)
     return None
 
 

@@ -268,7 +268,7 @@ def _answered(scene, frame):
         _show_frame(scene, frame)
         return
     for node in compute.ssao_nodes(scene):
-        if node.status.startswith("Rendering hidden surfaces"):
+        if node.status == compute.WAITING_STATUS.format(frame=frame):
             node.status = (f"Frame {frame}: without hidden surfaces (the frame changed before "
                            "they rendered)")
 
