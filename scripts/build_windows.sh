@@ -41,8 +41,11 @@ export WINEPREFIX=${WINEPREFIX:-$build/wineprefix} WINEDEBUG=-all WINEDLLOVERRID
 if [[ $tests == ON && ! -f "$WINEPREFIX/system.reg" ]]; then
   # Made once, before the build lists the tests with several Wine processes at a time.
   mkdir -p "$build"
-  wineboot --init >/dev/null 2>&1 || { echo "build_windows: wineboot --init failed" >&2; exit 1; }
+  wineboot --init </dev/null >/dev/null 2>&1 || { echo "build_windows: wineboot --init failed" >&2; exit 1; }
 fi
+# The build lists the tests by running them, capturing their output: Wine's server must not
+# hold those pipes (scripts/start_wine.sh says why).
+[[ $tests == OFF ]] || "$root/scripts/start_wine.sh"
 cmake -S "$root" -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=Release \
   -DCMAKE_TOOLCHAIN_FILE="$root/scripts/mingw-w64-x86_64.cmake" \
   -DSSAO_BUILD_TOOLS=OFF -DSSAO_BUILD_BENCHMARKS=OFF -DSSAO_BUILD_TESTS=$tests >/dev/null
@@ -61,5 +64,6 @@ done
 
 if [[ $run_tests == 1 ]]; then
   [[ $tests == ON ]] || { echo "build_windows: --run-tests with --no-tests" >&2; exit 2; }
+  "$root/scripts/start_wine.sh"  # ctest captures each test's output (start_wine.sh)
   ctest --test-dir "$build" --output-on-failure -j "$(nproc)"
 fi

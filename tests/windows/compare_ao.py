@@ -15,7 +15,9 @@ comparison; exit status 1 if any differs or any run fails.
     /usr/bin/python3 tests/windows/compare_ao.py --linux build/bin/raw_ao \
         --windows build-windows/bin/raw_ao.exe --sample tests/data --work /tmp/compare_ao
 
-wine runs with WINEDEBUG=-all and the caller's WINEPREFIX (if set).
+wine runs with WINEDEBUG=-all and the caller's WINEPREFIX (~/.wine if not set), whose server
+scripts/start_wine.sh starts first; each run's output goes to a file, never a pipe that a Wine
+process started by the run could hold open (start_wine.sh says why).
 """
 import argparse
 import json
@@ -23,6 +25,7 @@ import os
 import shlex
 import subprocess
 import sys
+import tempfile
 
 import numpy as np
 import OpenImageIO as oiio
@@ -89,14 +92,17 @@ def run(label, command, work, out, pixels, timeout, env=None):
     """Runs one raw_ao; returns the AO (float32, flat) or None after printing why it failed."""
     if os.path.exists(os.path.join(work, out)):
         os.remove(os.path.join(work, out))  # a stale output must not pass for this run's
-    try:
-        done = subprocess.run(command, cwd=work, env=env, capture_output=True, text=True,
-                              timeout=timeout)
-    except (OSError, subprocess.TimeoutExpired) as error:
-        print(f"[measure] {label}: FAILED: {error}\n    {shlex.join(command)}")
-        return None
+    with tempfile.TemporaryFile("w+") as stderr:
+        try:
+            done = subprocess.run(command, cwd=work, env=env, stdin=subprocess.DEVNULL,
+                                  stdout=subprocess.DEVNULL, stderr=stderr, timeout=timeout)
+        except (OSError, subprocess.TimeoutExpired) as error:
+            print(f"[measure] {label}: FAILED: {error}\n    {shlex.join(command)}")
+            return None
+        stderr.seek(0)
+        message = stderr.read()
     if done.returncode != 0:
-        why = (done.stderr.strip().splitlines() or ["(no message)"])[-1]
+        why = (message.strip().splitlines() or ["(no message)"])[-1]
         print(f"[measure] {label}: FAILED: exit {done.returncode}: {why}\n    {shlex.join(command)}")
         return None
     ao = np.fromfile(os.path.join(work, out), np.float32)
@@ -163,6 +169,9 @@ def main():
 
     linux = [os.path.abspath(args.linux)]
     windows = shlex.split(args.wine) + [os.path.abspath(args.windows)]
+    prefix = os.environ.get("WINEPREFIX") or os.path.expanduser("~/.wine")
+    subprocess.run(["bash", os.path.join(ROOT, "scripts", "start_wine.sh")], check=True,
+                   env=dict(os.environ, WINEPREFIX=prefix), stdin=subprocess.DEVNULL)
     ok = True
     for target in args.simd_targets.split(","):
         # The kernels of each SIMD target sum in their own order: both sides run the same one.
@@ -170,7 +179,7 @@ def main():
         env.pop("SSAO_SIMD_TARGET", None)
         if target != "default":
             env["SSAO_SIMD_TARGET"] = target
-        wine_env = dict(env, WINEDEBUG="-all")  # WINEPREFIX, if set, is inherited
+        wine_env = dict(env, WINEDEBUG="-all", WINEPREFIX=prefix)
         for variant in variants:
             ok &= compare_variant(variant, target, settings, width, height, linux, windows, env,
                                   wine_env, work, args.timeout)
