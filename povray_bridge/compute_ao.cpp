@@ -55,13 +55,14 @@ void set_up_job(ssao::api::Job& job, const Options& o, AoInputs& in, bool gamma,
   job.set_progress(&ssao_tools::InterruptGuard::cancel_if_interrupted, nullptr);
 }
 
-// Without --radius: libssao's automatic radius, printed so that the user can fix it.
-void choose_default_radius(ssao::api::Job& job, const Options& o, const AoInputs& in,
-                           const Reporter& report) {
-  if (o.param("radius")) return;
+// Without --radius: libssao's radius rule (no camera file here: the automatic radius), printed
+// so that the user can fix it.
+void choose_default_radius(ssao::api::Job& job, const AoInputs& in, const Reporter& report) {
   double radius = 0.0;
-  if (ssao_job_auto_radius(job.get(), &radius) != SSAO_OK) return;
-  job.set("radius", radius);
+  ssao_radius_source source = SSAO_RADIUS_SET;
+  // Failing only without a geometry pixel: AO is 1 whatever the radius.
+  if (ssao_job_choose_radius(job.get(), 1, &radius, &source) != SSAO_OK) return;
+  if (source != SSAO_RADIUS_AUTOMATIC) return;
   report.progress("radius %.4g scene units (10%% of the view's width%s; --radius to change)",
                   radius, in.camera.orthographic ? "" : " at the median depth");
 }
@@ -75,7 +76,7 @@ double compute_and_write(const Options& o, AoInputs& in, const Reporter& report)
   ssao::api::Job job;
   JobImages images;
   set_up_job(job, o, in, gamma, images);
-  choose_default_radius(job, o, in, report);
+  choose_default_radius(job, in, report);
 
   report.begin("AO (%s, normals %s, %s)... ", job.settings_summary().c_str(),
                in.normals.empty() ? "from depth" : "from the normal pass",

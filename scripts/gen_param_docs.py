@@ -38,10 +38,11 @@ FOOTER = """
 ## The automatic radius
 
 `radius` defaults to 1 scene unit in the library, which suits no scene in particular. The
-front ends choose one when the user gives none: the CLI takes the camera file's `ao_distance`,
-else, like `povray-ssao`, the library's rule `ssao_job_auto_radius()`: **10% of the view's
-width (along the image's larger side) at the median depth of the geometry pixels**;
-orthographic: 10% of the view's width. Both print the radius and the flag that changes it.
+front ends choose one when the user gives none, by the library's rule
+`ssao_job_choose_radius()` (the CLI, `povray-ssao` and the Python module all call it): the
+camera file's `ao_distance`, else the automatic radius `ssao_job_auto_radius()`: **10% of the
+view's width (along the image's larger side) at the median depth of the geometry pixels**;
+orthographic: 10% of the view's width. The tools print the radius and the flag that changes it.
 
 The 10% is the geometric mean over scenes whose AO distance an artist chose: the six benchmark
 scenes and the three development scenes (`/usr/bin/python3 benchmarks/radius_calibration.py`

@@ -70,15 +70,15 @@ void check_output_folder(const Options& options) {
   }
 }
 
-ssao_tools::Camera load_camera(const Options& options) {
-  ssao_tools::Camera camera = ssao_tools::read_camera_json(options.camera);
-  if (!options.quiet) {
-    for (const std::string& key : camera.unknown_keys) {
-      std::fprintf(stderr, "ssao: warning: camera file '%s': unknown key '%s' ignored\n",
-                   options.camera.c_str(), key.c_str());
-    }
+// Sets the job's camera from the camera file's text (the library reads the format), warning
+// about keys the format does not know.
+void apply_camera(ssao::api::Job& job, const std::string& text, const Options& options) {
+  const std::vector<std::string> unknown = ssao_tools::apply_camera_text(job, text, options.camera);
+  if (options.quiet) return;
+  for (const std::string& key : unknown) {
+    std::fprintf(stderr, "ssao: warning: camera file '%s': unknown key '%s' ignored\n",
+                 options.camera.c_str(), key.c_str());
   }
-  return camera;
 }
 
 // The channels the run reads: the passes found (or named) among the file's channels.
@@ -180,17 +180,12 @@ void attach_images(ssao::api::Job& job, Inputs& in, Outputs& out) {
   }
 }
 
-// World-space normals are turned through the camera's matrix: a camera file without one would
-// leave them unturned and the AO silently wrong, so such a run is refused.
-void require_camera_for_normals(const ssao::api::Job& job, const Inputs& in,
-                                const ssao_tools::Camera& camera, const std::string& camera_path) {
-  if (in.normal.empty() || camera.has_matrix_world) return;
-  if (job.get_string("normal_space") != "world") return;
-  throw ssao_tools::Error(
-      "camera file '" + camera_path +
-      "': missing key 'matrix_world', which the world-space normal pass needs; " +
-      "add it, or pass --normal-space camera for view-space normals, or " +
-      "--no-normals to reconstruct normals from depth");
+// What a run would get wrong without a word (the library's rule: world-space normals without
+// the camera's matrix), with this tool's flags for the way out.
+void check_inputs(const ssao::api::Job& job, const std::string& camera_path) {
+  if (ssao_job_check_inputs(job.get()) == SSAO_OK) return;
+  throw ssao_tools::Error("camera file '" + camera_path + "': " + ssao_last_error() +
+                          " (--normal-space camera, --no-normals)");
 }
 
 // Runs the job with progress on stderr; returns the time spent in milliseconds.
@@ -242,32 +237,24 @@ void print_summary(const Options& options, const ssao::api::Job& job, const Inpu
                1 + in.layer_depth.size(), milliseconds, mean.c_str(), count);
 }
 
-// Without --radius: the camera file's ao_distance, else the core's automatic rule; said on
-// stderr with how to change it.
-void choose_radius(const Options& options, const ssao_tools::Camera& camera, ssao::api::Job& job) {
-  for (const ssao_tools::ParamSetting& setting : options.params) {
-    if (setting.name == "radius") return;
-  }
-  std::string why;
-  if (camera.ao_distance > 0.0) {
-    job.set("radius", camera.ao_distance);
-    why = "ao_distance of " + options.camera;
-  } else {
-    double radius = 0.0;
-    const ssao_status status = ssao_job_auto_radius(job.get(), &radius);
-    if (status != SSAO_OK) return;  // no geometry: AO is 1 whatever the radius
-    job.set("radius", radius);
-    why = "10% of the view's width at the median depth";
-  }
-  if (!options.quiet) {
-    std::fprintf(stderr, "ssao: radius %.4g scene units (%s; --radius to change)\n",
-                 job.get_float("radius"), why.c_str());
-  }
+// Without --radius: the library's rule (the camera file's ao_distance, else the automatic
+// radius), said on stderr with how to change it.
+void choose_radius(const Options& options, ssao::api::Job& job) {
+  double radius = 0.0;
+  ssao_radius_source source = SSAO_RADIUS_SET;
+  // Failing only without a geometry pixel: AO is 1 whatever the radius.
+  if (ssao_job_choose_radius(job.get(), 1, &radius, &source) != SSAO_OK) return;
+  if (options.quiet || source == SSAO_RADIUS_SET) return;
+  const std::string why = source == SSAO_RADIUS_CAMERA_FILE
+                              ? "ao_distance of " + options.camera
+                              : "10% of the view's width at the median depth";
+  std::fprintf(stderr, "ssao: radius %.4g scene units (%s; --radius to change)\n", radius,
+               why.c_str());
 }
 
 // One frame of a sequence, read ahead while the previous one computes.
 struct FrameInputs {
-  ssao_tools::Camera camera;
+  std::string camera_text;
   Inputs in;
 };
 
@@ -323,12 +310,14 @@ void run_sequence(const Options& options) {
     throw UsageError(std::string("with --frames, ") + (input.has_frame() ? "-o" : "the input") +
                      " needs a frame placeholder (#### for 4 digits, @, or %04d)");
   }
-  bool radius_given = false;
-  for (const ParamSetting& setting : options.params) radius_given |= setting.name == "radius";
-  if (!radius_given) {
-    // Every frame must get the same radius, whichever machine or chunk renders it.
+  {
+    // Every frame must get the same radius, whichever machine or chunk renders it: --radius or
+    // the camera file's, never the automatic one.
     const Options first = frame_options(options, input, output, camera, options.frames.front());
-    if (!(load_camera(first).ao_distance > 0.0)) {
+    ssao::api::Job probe;
+    apply_camera(probe, ssao_tools::read_camera_text(first.camera), first);
+    ssao_tools::apply_params(probe, options.params);
+    if (ssao_job_choose_radius(probe.get(), 0, nullptr, nullptr) != SSAO_OK) {
       throw UsageError("a sequence needs --radius R, or \"ao_distance\" in its camera file ('" +
                        first.camera + "'): the automatic radius follows each frame's depth");
     }
@@ -349,7 +338,7 @@ void run_sequence(const Options& options) {
   Inputs spare;
   auto load = [](Options o, Inputs recycled) {
     FrameInputs f;
-    f.camera = load_camera(o);
+    f.camera_text = ssao_tools::read_camera_text(o.camera);
     f.in = load_inputs(o, std::move(recycled));
     return f;
   };
@@ -379,13 +368,13 @@ void run_sequence(const Options& options) {
                          [](int a, int b) { return a >= b; }) == options.sequence.end();
   std::set<int> estimated;  // the frames this job holds an estimate of
   auto run_frame = [&](int frame, FrameInputs& f, const Options& o) {
-    ssao_tools::apply_camera(job.get(), f.camera, o.camera);
+    apply_camera(job, f.camera_text, o);
     ssao_tools::apply_params(job, o.params);
     // Counted from the list's first frame: the library's frame numbers start at 0.
     job.set("frame", increasing ? frame - options.sequence.front() : -1);
     attach_images(job, f.in, out);
-    require_camera_for_normals(job, f.in, f.camera, o.camera);
-    choose_radius(o, f.camera, job);
+    check_inputs(job, o.camera);
+    choose_radius(o, job);
     job.set_progress(&ProgressReporter::callback, &interrupt);
     const ssao_status result = ssao_job_run(job.get());
     job.set_progress(nullptr, nullptr);
@@ -521,17 +510,17 @@ void run_ssao(const Options& options) {
   }
   refuse_overwriting_inputs(options);
   check_output_folder(options);
-  const ssao_tools::Camera camera = load_camera(options);
+  const std::string camera_text = ssao_tools::read_camera_text(options.camera);
 
   ssao::api::Job job;
-  ssao_tools::apply_camera(job.get(), camera, options.camera);
+  apply_camera(job, camera_text, options);
   ssao_tools::apply_params(job, options.params);  // after the camera: a flag overrides the file
 
   Inputs in = load_inputs(options);
   Outputs out;
   attach_images(job, in, out);
-  require_camera_for_normals(job, in, camera, options.camera);
-  choose_radius(options, camera, job);
+  check_inputs(job, options.camera);
+  choose_radius(options, job);
   const double milliseconds = compute_ao(job, options.quiet);
   write_output(options, in, out);
   if (!options.quiet) print_summary(options, job, in, milliseconds);

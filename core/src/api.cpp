@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: MIT
 // The C boundary: every entry point checks its handle, calls into C++, and turns exceptions into
 // a status plus a per-thread message. Nothing else in the library knows about C.
+#include <algorithm>
 #include <cstring>
 #include <new>
 #include <string>
@@ -34,6 +35,13 @@ ssao_status guarded(Fn&& fn) {
   } catch (...) {
     return fail(SSAO_ERROR_INTERNAL, "unknown internal error");
   }
+}
+
+// A C string of at most size - 1 characters (size > 0).
+void copy_truncated(const std::string& value, char* out, size_t size) {
+  const size_t n = std::min(size - 1, value.size());
+  std::memcpy(out, value.data(), n);
+  out[n] = '\0';
 }
 
 ssao::Job& checked(ssao_job job) {
@@ -141,10 +149,7 @@ SSAO_API ssao_status ssao_job_get_float(ssao_job job, const char* name, double* 
 SSAO_API ssao_status ssao_job_get_string(ssao_job job, const char* name, char* out, size_t size) {
   return guarded([&] {
     if (out == nullptr || size == 0) ssao::throw_invalid_argument("output buffer is NULL or empty");
-    const std::string& value = checked(job).params().get_string(name);
-    const size_t n = std::min(size - 1, value.size());
-    std::memcpy(out, value.data(), n);
-    out[n] = '\0';
+    copy_truncated(checked(job).params().get_string(name), out, size);
   });
 }
 
@@ -198,6 +203,44 @@ SSAO_API ssao_status ssao_job_last_run(ssao_job job, size_t* geometry_pixels, do
     *geometry_pixels = stats.geometry_pixels;
     *mean_ao = stats.mean_ao;
   });
+}
+
+SSAO_API ssao_status ssao_job_set_camera_json(ssao_job job, const char* json_text,
+                                              const char* source) {
+  return guarded([&] {
+    if (json_text == nullptr) ssao::throw_invalid_argument("camera file text is NULL");
+    checked(job).set_camera_json(json_text, source != nullptr ? source : "camera");
+  });
+}
+
+SSAO_API ssao_status ssao_job_camera_unknown_keys(ssao_job job, char* out, size_t size) {
+  return guarded([&] {
+    if (out == nullptr || size == 0) ssao::throw_invalid_argument("output buffer is NULL or empty");
+    std::string keys;
+    for (const std::string& key : checked(job).camera_file().unknown_keys)
+      keys += (keys.empty() ? "" : ",") + key;
+    copy_truncated(keys, out, size);
+  });
+}
+
+SSAO_API ssao_status ssao_job_is_set(ssao_job job, const char* name, int* out) {
+  return guarded([&] {
+    if (out == nullptr) ssao::throw_invalid_argument("output pointer is NULL");
+    *out = checked(job).params().is_set(name) ? 1 : 0;
+  });
+}
+
+SSAO_API ssao_status ssao_job_choose_radius(ssao_job job, int allow_automatic, double* radius,
+                                            ssao_radius_source* source) {
+  return guarded([&] {
+    const ssao::Job::RadiusSource chosen = checked(job).choose_radius(allow_automatic != 0);
+    if (radius != nullptr) *radius = job->params().get_float("radius");
+    if (source != nullptr) *source = static_cast<ssao_radius_source>(chosen);
+  });
+}
+
+SSAO_API ssao_status ssao_job_check_inputs(ssao_job job) {
+  return guarded([&] { checked(job).check_inputs(); });
 }
 
 }  // extern "C"

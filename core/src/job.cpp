@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <cstring>
 #include <limits>
+#include <utility>
 #include <vector>
 
 #include "camera.h"
@@ -30,21 +31,6 @@ int layer_number(const char* name, const char* prefix) {
   }
   const int number = name[length] - '0';
   return number >= 2 && number <= kMaxExtraLayers + 1 ? number : 0;
-}
-
-CameraParams camera_params(const ParamValues& v) {
-  CameraParams c;
-  c.orthographic = v.get_string("camera_type") == "ORTHO";
-  c.lens = v.get_float("lens");
-  c.sensor_width = v.get_float("sensor_width");
-  c.sensor_height = v.get_float("sensor_height");
-  c.sensor_fit = v.get_string("sensor_fit");
-  c.shift_x = v.get_float("shift_x");
-  c.shift_y = v.get_float("shift_y");
-  c.ortho_scale = v.get_float("ortho_scale");
-  c.pixel_aspect_x = v.get_float("pixel_aspect_x");
-  c.pixel_aspect_y = v.get_float("pixel_aspect_y");
-  return c;
 }
 
 // The camera of a width x height frame as the parameter "projection" says it is given.
@@ -441,6 +427,41 @@ TilePool& Job::pool(int threads) {
     pool_ = std::make_unique<TilePool>(threads);
   }
   return *pool_;
+}
+
+void Job::set_camera_json(const std::string& text, const std::string& source) {
+  ParamValues params = params_;  // an error leaves the job as it was
+  params.reset_group("camera");  // the file describes the whole camera
+  CameraFile file = apply_camera_json(text, source, params);
+  params_ = std::move(params);
+  camera_file_ = std::move(file);
+}
+
+Job::RadiusSource Job::choose_radius(bool allow_automatic) {
+  if (params_.is_set("radius")) return RadiusSource::set;
+  // Chosen, not set: the next call (a new camera file, a new depth) chooses again.
+  if (camera_file_.ao_distance > 0.0) {
+    params_.set_float_default("radius", camera_file_.ao_distance);
+    return RadiusSource::camera_file;
+  }
+  if (!allow_automatic) {
+    throw_invalid_operation(
+        "no radius: set the parameter radius, or give \"ao_distance\" in the camera file");
+  }
+  params_.set_float_default("radius", auto_radius());
+  return RadiusSource::automatic;
+}
+
+void Job::check_inputs() const {
+  // World-space normals are turned into view space through camera_to_world: its identity
+  // default would turn them wrong without a word.
+  if (normal_.attached() && params_.get_string("normal_space") == "world" &&
+      !params_.is_set("camera_to_world")) {
+    throw_invalid_argument(
+        "missing key 'matrix_world' (or the parameter camera_to_world): the camera's matrix, "
+        "which world-space normals need; add it, or set normal_space to camera for view-space "
+        "normals, or give no normal pass (normals rebuilt from depth)");
+  }
 }
 
 Job::RunStats Job::last_run() const {

@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "camera_file.h"
 #include "frame.h"
 #include "image_view.h"
 #include "params.h"
@@ -32,6 +33,14 @@ class Job {
   void run();
   // The automatic radius rule (docs/parameters.md) for the attached depth image and camera.
   double auto_radius() const;
+
+  // The front ends' rules (ssao.h): a camera file's text sets the camera (all of it or none),
+  // the radius when none was set, and what a run cannot tell from wrong.
+  void set_camera_json(const std::string& text, const std::string& source);
+  const CameraFile& camera_file() const { return camera_file_; }
+  enum class RadiusSource { set = 0, camera_file = 1, automatic = 2 };
+  RadiusSource choose_radius(bool allow_automatic);
+  void check_inputs() const;
 
   // What the last successful run saw over the frame (the output window): the pixels the
   // background rule took as geometry and the mean of their final AO (1 without any).
@@ -69,6 +78,7 @@ class Job {
 
   ImageView depth_, normal_, beauty_, ambient_, ao_out_, composite_out_;
   ImageView layers_[kMaxExtraLayers], facing_[kMaxExtraLayers];
+  CameraFile camera_file_;
   RunStats last_run_;
   bool has_run_ = false;
   bool windowed_ = false;

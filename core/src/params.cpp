@@ -272,29 +272,49 @@ ParamValues::ParamValues() : values_(table().size()) {
   }
 }
 
-size_t ParamValues::index_of(const char* name, ssao_param_type expected) const {
+size_t ParamValues::index_of(const char* name) const {
   if (name == nullptr) throw_invalid_argument("parameter name is NULL");
   for (size_t i = 0; i < table().size(); ++i) {
-    if (std::strcmp(table()[i].name, name) != 0) continue;
-    if (table()[i].type != expected) {
-      throw_invalid_argument(std::string("parameter '") + name + "' is " +
-                             type_name(table()[i].type) + ", not " + type_name(expected));
-    }
-    return i;
+    if (std::strcmp(table()[i].name, name) == 0) return i;
   }
   throw_invalid_argument(std::string("unknown parameter '") + name + "'");
+}
+
+size_t ParamValues::index_of(const char* name, ssao_param_type expected) const {
+  const size_t i = index_of(name);
+  if (table()[i].type != expected) {
+    throw_invalid_argument(std::string("parameter '") + name + "' is " +
+                           type_name(table()[i].type) + ", not " + type_name(expected));
+  }
+  return i;
+}
+
+bool ParamValues::is_set(const char* name) const { return values_[index_of(name)].set; }
+
+void ParamValues::set_float_default(const char* name, double value) {
+  set_float(name, value);
+  values_[index_of(name)].set = false;
+}
+
+void ParamValues::reset_group(const char* group) {
+  const ParamValues defaults;
+  for (size_t i = 0; i < table().size(); ++i) {
+    if (std::strcmp(param_group(i), group) == 0) values_[i] = defaults.values_[i];
+  }
 }
 
 void ParamValues::set_int(const char* name, int value) {
   const size_t i = index_of(name, SSAO_PARAM_INT);
   check_range(table()[i], value);
   values_[i].number = value;
+  values_[i].set = true;
 }
 
 void ParamValues::set_float(const char* name, double value) {
   const size_t i = index_of(name, SSAO_PARAM_FLOAT);
   check_range(table()[i], value);
   values_[i].number = value;
+  values_[i].set = true;
 }
 
 void ParamValues::set_string(const char* name, const char* value) {
@@ -305,6 +325,7 @@ void ParamValues::set_string(const char* name, const char* value) {
                            table()[i].choices + ", got '" + value + "'");
   }
   values_[i].text = value;
+  values_[i].set = true;
 }
 
 void ParamValues::set_floats(const char* name, const double* values, size_t count) {
@@ -322,6 +343,7 @@ void ParamValues::set_floats(const char* name, const double* values, size_t coun
     }
   }
   values_[i].floats.assign(values, values + count);
+  values_[i].set = true;
 }
 
 int ParamValues::get_int(const char* name) const {

@@ -29,13 +29,23 @@ class ParamValues {
   double get_float(const char* name) const;
   const std::string& get_string(const char* name) const;
   const std::vector<double>& get_floats(const char* name) const;
+  // Whether a set_* call (or a camera file) gave the parameter its value on this job: the
+  // front ends' rules ask whether the radius and the camera's matrix were given.
+  bool is_set(const char* name) const;
+  // A value a rule chose, not the caller: it keeps is_set() false, so the rule chooses again
+  // next time (Job::choose_radius).
+  void set_float_default(const char* name, double value);
+  // Every parameter of `group` (param_group) back to its default, not set.
+  void reset_group(const char* group);
 
  private:
   struct Value {
     double number = 0.0;
     std::string text;
     std::vector<double> floats;
+    bool set = false;  // given by a set_* call, not the table's default
   };
+  size_t index_of(const char* name) const;
   size_t index_of(const char* name, ssao_param_type expected) const;
   std::vector<Value> values_;
 };

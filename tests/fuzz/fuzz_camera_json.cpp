@@ -1,58 +1,67 @@
 // SPDX-License-Identifier: MIT
-// libFuzzer target: the camera file of the command-line tool (--camera) on random text:
-// ssao_tools::parse_camera_json (nlohmann-json), then apply_camera onto a job as the CLI does. Both
-// must either work or throw ssao_tools::Error. A camera that parses must hold what the format
-// promises (core/tools/camera_json.h): finite numbers, known choices, an affine matrix.
+// libFuzzer target: the camera file's one reader, ssao_job_set_camera_json (core/src/
+// camera_file.cpp, nlohmann-json), on random text, as the CLI, the evaluation tools and the
+// Python module call it. It must either set a camera that holds what the format promises
+// (known choices, finite numbers, an affine camera_to_world) or refuse with a message and
+// leave every parameter of the job as it was.
 #include <cmath>
 #include <cstdint>
-#include <cstdio>
-#include <cstdlib>
+#include <cstring>
 #include <string>
+#include <vector>
 
 #include "fuzz_common.h"
 #include "ssao/ssao.hpp"
-#include "tools/camera_json.h"
 
 namespace {
 
 using fuzz::check;
 
+// Every parameter's value as text, to compare a job before and after a refused file.
+std::string snapshot(const ssao::api::Job& job) {
+  std::string out;
+  for (const ssao_param_desc& d : ssao::api::param_table()) {
+    out += d.name;
+    out += '=';
+    if (d.type == SSAO_PARAM_STRING) {
+      out += job.get_string(d.name);
+    } else if (d.type == SSAO_PARAM_FLOATS) {
+      for (double v : job.get_floats(d.name, d.count)) out += std::to_string(v) + ",";
+    } else if (d.type == SSAO_PARAM_INT) {
+      out += std::to_string(job.get_int(d.name));
+    } else {
+      out += std::to_string(job.get_float(d.name));
+    }
+    out += job.is_set(d.name) ? " set;" : ";";
+  }
+  return out;
+}
+
 }  // namespace
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
-  const std::string text(reinterpret_cast<const char*>(data), size);
-  ssao_tools::Camera camera;
-  try {
-    camera = ssao_tools::parse_camera_json(text, "fuzz.camera.json");
-  } catch (const ssao_tools::Error&) {
-    return 0;  // refused with a message: what the CLI prints
-  }
-  check(camera.type == "PERSP" || camera.type == "ORTHO", "unknown type accepted");
-  check(camera.sensor_fit == "AUTO" || camera.sensor_fit == "HORIZONTAL" ||
-            camera.sensor_fit == "VERTICAL",
-        "unknown sensor_fit accepted");
-  for (double v : {camera.lens, camera.sensor_width, camera.sensor_height, camera.shift_x,
-                   camera.shift_y, camera.ortho_scale, camera.clip_start, camera.clip_end,
-                   camera.pixel_aspect_x, camera.pixel_aspect_y, camera.ao_distance}) {
-    check(std::isfinite(v), "a non-finite number accepted");
-  }
-  for (double v : camera.matrix_world) check(std::isfinite(v), "a non-finite matrix accepted");
-  check(camera.projection == "lens" || camera.projection == "intrinsics" ||
-            camera.projection == "matrix",
-        "unknown projection accepted");
-  check(camera.intrinsics.empty() || camera.intrinsics.size() == 4, "intrinsics not 4 values");
-  check(camera.projection_matrix.empty() || camera.projection_matrix.size() == 16,
-        "projection_matrix not 16 values");
-  for (double v : camera.intrinsics) check(std::isfinite(v), "non-finite intrinsics accepted");
-  for (double v : camera.projection_matrix) check(std::isfinite(v), "non-finite matrix accepted");
-  check(camera.matrix_world[12] == 0.0 && camera.matrix_world[13] == 0.0 &&
-            camera.matrix_world[14] == 0.0 && camera.matrix_world[15] == 1.0,
-        "a non-affine matrix accepted");
+  // A C string: the text up to its first NUL (the tools refuse a NUL before calling).
+  const std::string text(reinterpret_cast<const char*>(data),
+                         strnlen(reinterpret_cast<const char*>(data), size));
   ssao::api::Job job;
-  try {
-    ssao_tools::apply_camera(job.get(), camera, "fuzz.camera.json");
-  } catch (const ssao::api::Error&) {
-    // The core refused a value (e.g. a lens outside its range): the CLI reports it.
+  job.set("lens", 35.0);  // a job that is not all defaults: a refusal must keep it
+  const std::string before = snapshot(job);
+  if (ssao_job_set_camera_json(job.get(), text.c_str(), "fuzz.camera.json") != SSAO_OK) {
+    check(std::strlen(ssao_last_error()) > 0, "refused without a message");
+    check(snapshot(job) == before, "a refused camera file changed the job");
+    return 0;
   }
+  const std::string type = job.get_string("camera_type");
+  check(type == "PERSP" || type == "ORTHO", "unknown type accepted");
+  for (const char* name : {"lens", "sensor_width", "sensor_height", "ortho_scale", "pixel_aspect_x",
+                           "pixel_aspect_y"}) {
+    check(job.get_float(name) > 0.0 && std::isfinite(job.get_float(name)),
+          "a size that is not positive and finite accepted");
+  }
+  const std::vector<double> matrix = job.get_floats("camera_to_world", 16);
+  for (double v : matrix) check(std::isfinite(v), "a non-finite matrix accepted");
+  check(matrix[12] == 0.0 && matrix[13] == 0.0 && matrix[14] == 0.0 && matrix[15] == 1.0,
+        "a non-affine matrix accepted");
+  job.camera_unknown_keys();
   return 0;
 }

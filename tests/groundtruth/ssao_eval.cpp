@@ -38,7 +38,8 @@
 #include <utility>
 #include <vector>
 
-#include "camera.h"  // core/src (through ssao_reference): the camera model of the references
+#include "camera.h"       // core/src (through ssao_reference): the camera model of the references
+#include "camera_file.h"  // and the camera file's reader
 #include "reference_ao.h"
 #include "ssao/ssao.hpp"
 #include "tools/blender_passes.h"
@@ -331,11 +332,16 @@ struct Scene {
   std::string name;  // file name without folder and extension
   std::string path;
   int width = 0, height = 0;
-  ssao_tools::Camera camera;
-  std::vector<float> depth;         // planar, 1 channel
-  std::vector<float> world_normal;  // 3 channels or empty
-  std::vector<float> truth;         // the AO pass
-  std::vector<unsigned char> mask;  // pixels that are scored
+  // The camera file's text (the library reads it for the core) and what the references need of
+  // it, read back from a job it was applied to.
+  std::string camera_text;
+  ssao::CameraParams camera;
+  double clip_end = 0.0;             // 0: no clip test
+  std::vector<double> matrix_world;  // camera-to-world, row-major, 16 values
+  std::vector<float> depth;          // planar, 1 channel
+  std::vector<float> world_normal;   // 3 channels or empty
+  std::vector<float> truth;          // the AO pass
+  std::vector<unsigned char> mask;   // pixels that are scored
   size_t scored = 0;
   // From --layers: the same render's passes on a frame grown by `band` pixels a side (the
   // display window at (band, band)), and its 2nd, 3rd, ... hits with their facing.
@@ -392,7 +398,7 @@ void drop_hits_not_behind(const Options& o, Scene& s) {
         s.layer_depth[k][p] = hit.first;
         if (!s.layer_facing[k].empty()) s.layer_facing[k][p] = hit.second;
       }
-      if (changed && is_surface(depth, s.camera.clip_end)) ++(inside ? in_frame : in_band);
+      if (changed && is_surface(depth, s.clip_end)) ++(inside ? in_frame : in_band);
     }
   }
   std::fprintf(stderr,
@@ -435,10 +441,24 @@ Scene load_scene(const Options& o) {
   s.path = o.scene;
   s.name = std::filesystem::path(o.scene).stem().string();
   // The camera first: it is small and a mistake there is cheaper to find.
-  s.camera = ssao_tools::read_camera_json(o.camera);
-  for (const std::string& key : s.camera.unknown_keys) {
-    std::fprintf(stderr, "%s: warning: camera file '%s': unknown key '%s' ignored\n", kProgram,
-                 o.camera.c_str(), key.c_str());
+  s.camera_text = ssao_tools::read_camera_text(o.camera);
+  {
+    // The library's own reader (core/src/camera_file.h, which the C API calls), into
+    // parameters the references read from.
+    ssao::ParamValues params;
+    ssao::CameraFile file;
+    try {
+      file = ssao::apply_camera_json(s.camera_text, o.camera, params);
+    } catch (const ssao::api::Error& e) {
+      throw ssao_tools::Error(e.what());
+    }
+    for (const std::string& key : file.unknown_keys) {
+      std::fprintf(stderr, "%s: warning: camera file '%s': unknown key '%s' ignored\n", kProgram,
+                   o.camera.c_str(), key.c_str());
+    }
+    s.camera = ssao::camera_params(params);
+    s.clip_end = params.get_float("clip_end");
+    s.matrix_world = params.get_floats("camera_to_world");
   }
 
   ssao_tools::Image image = ssao_tools::read_image(o.scene);
@@ -463,7 +483,7 @@ Scene load_scene(const Options& o) {
   }
   s.truth = ssao_tools::extract_channels(image, {ao_index});
 
-  const double limit = 0.9 * s.camera.clip_end;
+  const double limit = 0.9 * s.clip_end;
   s.mask.assign(s.depth.size(), 0);
   for (size_t p = 0; p < s.depth.size(); ++p) {
     const float d = s.depth[p];
@@ -531,21 +551,10 @@ ssao_ref::DepthScene reference_scene(const Scene& s) {
   ssao_ref::DepthScene d;
   d.width = s.width;
   d.height = s.height;
-  ssao::CameraParams p;
-  p.orthographic = s.camera.type == "ORTHO";
-  p.lens = s.camera.lens;
-  p.sensor_width = s.camera.sensor_width;
-  p.sensor_height = s.camera.sensor_height;
-  p.sensor_fit = s.camera.sensor_fit;
-  p.shift_x = s.camera.shift_x;
-  p.shift_y = s.camera.shift_y;
-  p.ortho_scale = s.camera.ortho_scale;
-  p.pixel_aspect_x = s.camera.pixel_aspect_x;
-  p.pixel_aspect_y = s.camera.pixel_aspect_y;
-  d.camera = ssao::CameraModel(p, s.width, s.height);
+  d.camera = ssao::CameraModel(s.camera, s.width, s.height);
 
   d.depth = s.depth;
-  const double clip_end = s.camera.clip_end;
+  const double clip_end = s.clip_end;
   for (float& depth : d.depth) {
     if (clip_end > 0.0 && static_cast<double>(depth) >= clip_end) {
       depth = std::numeric_limits<float>::infinity();
@@ -555,7 +564,7 @@ ssao_ref::DepthScene reference_scene(const Scene& s) {
   if (!s.world_normal.empty()) {
     // World to view for normals: the inverse transpose of the world-to-camera linear part, that
     // is the transpose of camera_to_world's 3x3 (exact even if the camera is scaled).
-    const std::vector<double>& m = s.camera.matrix_world;  // row-major, 16 values
+    const std::vector<double>& m = s.matrix_world;  // row-major, 16 values
     d.view_normal.resize(s.world_normal.size());
     for (size_t p3 = 0; p3 < s.world_normal.size(); p3 += 3) {
       const double wx = s.world_normal[p3], wy = s.world_normal[p3 + 1],
@@ -738,7 +747,7 @@ Method make_method(const std::string& name, const std::vector<Setting>& settings
     const std::vector<ssao_param_desc> table = ssao::api::param_table();
     auto state = std::make_shared<CoreState>();
     ssao::api::Job& job = state->job;
-    if (scene != nullptr) ssao_tools::apply_camera(job.get(), scene->camera, scene->path);
+    if (scene != nullptr) ssao_tools::apply_camera_text(job, scene->camera_text, scene->path);
     try {
       job.set("radius", radius);
     } catch (const ssao::api::Error&) {

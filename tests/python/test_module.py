@@ -362,19 +362,19 @@ class BadInput(unittest.TestCase):
         self.refused(r"'threads' is out of range", threads=2**40)
         self.refused(r"'threads' must be an int, got float", threads=2.0)
         self.refused(r"'radius' must be a number, got str", radius="0.8")
-        self.refused(r"camera key 'lens' must be a finite number, got nan",
+        self.refused(r"camera file 'camera': key 'lens' must be a finite number, got nan",
                      camera=dict(self.camera, lens=float("nan")))
-        self.refused(r"camera key 'lens' must be a finite number", camera=dict(self.camera,
-                                                                               lens=10**400))
+        self.refused(r"key 'lens' must be a finite number",
+                     camera=dict(self.camera, lens=10**400))
         self.refused(r"'radius' is out of range", radius=10**400)
-        self.refused(r"camera key 'clip_end' must be positive, got 0",  # the CLI's rule
+        self.refused(r"key 'clip_end' must be positive, got 0",  # the CLI's rule
                      camera=dict(self.camera, clip_end=0))
-        self.refused(r"camera key 'clip_start' must not be negative",
+        self.refused(r"key 'clip_start' must not be negative",
                      camera=dict(self.camera, clip_start=-1.0))
-        self.refused(r"camera key 'ao_distance' must be a finite number",
+        self.refused(r"key 'ao_distance' must be a finite number",
                      camera=dict(self.camera, ao_distance=float("inf")), radius=None)
-        self.refused(r"camera key 'lens' must be positive", camera=dict(self.camera, lens=-35.0))
-        self.refused(r"camera: .*'shift_x' must be in", camera=dict(self.camera, shift_x=5000))
+        self.refused(r"key 'lens' must be positive", camera=dict(self.camera, lens=-35.0))
+        self.refused(r"camera file 'camera': .*'shift_x' must be in", camera=dict(self.camera, shift_x=5000))
         self.refused(r"no geometry pixel", np.full_like(self.contiguous, np.nan))
         self.refused(r"no geometry pixel", np.full_like(self.contiguous, np.nan), radius=None)
 
@@ -390,13 +390,13 @@ class BadInput(unittest.TestCase):
         self.refused(r"'matrix_world' must be an affine transform", camera=dict(
             self.camera, matrix_world=[[1, 0, 0, 0]] * 4))
         no_matrix = {k: v for k, v in self.camera.items() if k != "matrix_world"}
-        self.refused(r"missing the camera's matrix .* which world-space normals need",
+        self.refused(r"missing key 'matrix_world'.* which world-space normals need",
                      normals=self.normals, camera=no_matrix)
-        self.refused(r"missing the camera's matrix", normals=self.normals, camera=None,
+        self.refused(r"missing key 'matrix_world' \(or the parameter camera_to_world\)", normals=self.normals, camera=None,
                      lens=35.0)
-        self.refused(r"camera key 'intrinsics' must be a number, got str", camera={
+        self.refused(r"key 'intrinsics\[0\]' must be a number, got a string", camera={
             "projection": "intrinsics", "type": "PERSP", "intrinsics": ["100", 100, 120, 67]})
-        self.refused(r"camera key 'matrix_world' must be a number, got bool", camera=dict(
+        self.refused(r"key 'matrix_world\[0\]\[0\]' must be a number, got a boolean", camera=dict(
             self.camera, matrix_world=[[True, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, 0],
                                        [0, 0, 0, 1]]))
         self.refused(r"'camera_to_world' must be a sequence of numbers, got set",
@@ -409,7 +409,7 @@ class BadInput(unittest.TestCase):
             ssao.ambient_occlusion(self.contiguous, normals=self.normals, camera=self.camera,
                                    radius=0.8))
         self.refused(r"camera must be a dict .* or a camera file's path, got int", camera=3)
-        self.refused(r"camera: parameter 'shift_x' must be a number, got str",
+        self.refused(r"key 'shift_x' must be a number, got a string",
                      camera=dict(self.camera, shift_x="0"))
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always")

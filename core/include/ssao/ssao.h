@@ -217,6 +217,49 @@ SSAO_API ssao_status ssao_job_run(ssao_job job);
  * SSAO_ERROR_INVALID_OPERATION when the job has not run, or its last run failed. */
 SSAO_API ssao_status ssao_job_last_run(ssao_job job, size_t* geometry_pixels, double* mean_ao);
 
+/* The front ends' rules, in one place: the CLI, the POV-Ray bridge, the Python module and the
+ * Blender add-on call these rather than writing them again. */
+
+/* Sets the camera from the text of a camera file (JSON; docs/conventions.md, "Camera file":
+ * Blender's camera property names, or another renderer's intrinsics or projection matrix). The
+ * one reader of the format: it checks every rule (the keys the projection needs, the types of
+ * the values, finite numbers, positive sizes, matrix shapes, the library's ranges) and sets the
+ * camera parameters the file holds; the job's other camera parameters go back to their defaults
+ * (the file describes the whole camera: set overrides after it). On an error nothing is set
+ * and ssao_last_error() names `source` (NULL: "camera") and the key. The file's "ao_distance"
+ * is remembered for ssao_job_choose_radius(); keys the format does not know are ignored and
+ * listed by ssao_job_camera_unknown_keys(). */
+SSAO_API ssao_status ssao_job_set_camera_json(ssao_job job, const char* json_text,
+                                              const char* source);
+/* The keys of the last camera file that the format does not know, comma-separated ("" for none),
+ * truncated to size - 1 characters as ssao_job_get_string truncates. */
+SSAO_API ssao_status ssao_job_camera_unknown_keys(ssao_job job, char* out, size_t size);
+/* 1 in *out if a set call or a camera file gave the parameter its value on this job, else 0 (it
+ * holds the default). */
+SSAO_API ssao_status ssao_job_is_set(ssao_job job, const char* name, int* out);
+
+/* Where ssao_job_choose_radius() took the radius from. */
+typedef enum {
+  SSAO_RADIUS_SET = 0,         /* "radius" was set on the job: kept */
+  SSAO_RADIUS_CAMERA_FILE = 1, /* the camera file's "ao_distance" */
+  SSAO_RADIUS_AUTOMATIC = 2    /* ssao_job_auto_radius() */
+} ssao_radius_source;
+/* The radius rule when the user gave none: a radius set on the job stays; else the camera
+ * file's "ao_distance"; else, if allow_automatic is non-zero, the automatic radius (which needs
+ * the depth image, and fails as ssao_job_auto_radius() fails when no pixel has geometry). Sets
+ * "radius" (as chosen, not set: a later call, after a new camera file or depth, chooses again)
+ * and writes it to *radius and the rule to *source (either may be NULL). With allow_automatic = 0
+ * and neither: SSAO_ERROR_INVALID_OPERATION (a sequence wants one radius for every frame, which the
+ * automatic rule does not give). */
+SSAO_API ssao_status ssao_job_choose_radius(ssao_job job, int allow_automatic, double* radius,
+                                            ssao_radius_source* source);
+/* Checks the inputs for what a run would take without a word and get wrong: world-space normals
+ * (a "normal" image with normal_space "world") without the camera's matrix (camera_to_world,
+ * or a camera file's "matrix_world"), which its identity default would turn wrong. Call it before
+ * ssao_job_run(), after the images and parameters: SSAO_OK, or SSAO_ERROR_INVALID_ARGUMENT with
+ * the message. (ssao_job_run() does not call it: a caller may mean the identity.) */
+SSAO_API ssao_status ssao_job_check_inputs(ssao_job job);
+
 #ifdef __cplusplus
 }
 #endif

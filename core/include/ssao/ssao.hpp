@@ -114,6 +114,44 @@ class Job {
     check_status(ssao_job_auto_radius(job_, &radius), "automatic radius");
     return radius;
   }
+  // The camera of a camera file's text (ssao_job_set_camera_json); `source` names it in messages,
+  // which carry their own context.
+  void set_camera_json(const std::string& text, const std::string& source) {
+    check_status(ssao_job_set_camera_json(job_, text.c_str(), source.c_str()), "");
+  }
+  // The keys of the last camera file that the format does not know.
+  std::vector<std::string> camera_unknown_keys() const {
+    char buffer[4096] = {};
+    check_status(ssao_job_camera_unknown_keys(job_, buffer, sizeof buffer), "camera file");
+    std::vector<std::string> keys;
+    std::string key;
+    for (const char* c = buffer;; ++c) {
+      if (*c == ',' || *c == '\0') {
+        if (!key.empty()) keys.push_back(key);
+        key.clear();
+        if (*c == '\0') break;
+      } else {
+        key += *c;
+      }
+    }
+    return keys;
+  }
+  bool is_set(const std::string& name) const {
+    int set = 0;
+    check_status(ssao_job_is_set(job_, name.c_str(), &set), "parameter " + name);
+    return set != 0;
+  }
+  // The radius rule without a radius from the user (ssao_job_choose_radius): the radius and
+  // where it came from.
+  std::pair<double, ssao_radius_source> choose_radius(bool allow_automatic) {
+    double radius = 0.0;
+    ssao_radius_source source = SSAO_RADIUS_SET;
+    check_status(ssao_job_choose_radius(job_, allow_automatic ? 1 : 0, &radius, &source), "");
+    return {radius, source};
+  }
+  // What a run would get wrong without a word (ssao_job_check_inputs).
+  void check_inputs() const { check_status(ssao_job_check_inputs(job_), ""); }
+
   // "hemisphere, quality medium" plus any count set explicitly (", 16 samples"): what the
   // front ends print about a run (a count left at 0 comes from the quality preset).
   std::string settings_summary() const {

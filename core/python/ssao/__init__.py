@@ -45,69 +45,41 @@ def variants(lib=None):
     return _binding.variants(lib or library())
 
 
-# A camera file's keys (docs/conventions.md, "Camera file") that are not the library parameter
-# of the same name, and the shapes of its matrices. Every other key of the format is a camera
-# parameter of the library under its own name, which checks its range.
-_CAMERA_RENAMED = {"type": "camera_type", "matrix_world": "camera_to_world"}
-_CAMERA_MATRICES = {"matrix_world": (4, 4), "projection_matrix": (4, 4), "intrinsics": (4,)}
-_CAMERA_ONLY = ("ao_distance",)  # the AO radius the shot was made for: not a camera parameter
-# Numbers the camera file requires positive or not negative (camera_json.cpp's checks; the
-# library's own ranges allow clip_end 0, "no clip test", which a file cannot say).
-_CAMERA_POSITIVE = ("lens", "sensor_width", "sensor_height", "ortho_scale", "clip_end",
-                    "pixel_aspect_x", "pixel_aspect_y", "ao_distance")
-_CAMERA_NOT_NEGATIVE = ("clip_start",)
+def _camera_text(camera):
+    """A camera file's dict as the file's text, for the library's reader (ssao_job_set_camera_json,
+    which checks every rule of the format). numpy values become numbers and lists. JSON has no
+    number that is not finite: such a value is refused here, named as the reader names keys."""
+    if not isinstance(camera, dict):
+        raise SSAOError(f"camera must be a dict (a camera file's keys) or a camera file's "
+                        f"path, got {type(camera).__name__}")
 
+    def plain(value, key):
+        if hasattr(value, "tolist") and not isinstance(value, (str, bytes)):
+            value = value.tolist()  # numpy arrays and scalars
+        if isinstance(value, (list, tuple)):
+            return [plain(v, f"{key}[{k}]") for k, v in enumerate(value)]
+        if isinstance(value, numbers.Real) and not isinstance(value, bool):
+            try:
+                number = float(value)
+            except OverflowError:  # an int beyond any float
+                number = math.inf
+            if not math.isfinite(number):
+                raise SSAOError(f"camera file 'camera': key '{key}' must be a finite number, "
+                                f"got {value}")
+            return value if isinstance(value, int) else number
+        return value
 
-def _camera_keys():
-    """{camera file key: library parameter} for every camera parameter of the library."""
-    names = [p["name"] for p in parameters() if p["group"] == "camera"]
-    key_of = {param: key for key, param in _CAMERA_RENAMED.items()}
-    return {key_of.get(name, name): name for name in names}
-
-
-def _required_camera_keys(camera):
-    """The keys the camera's projection depends on, which a camera file must have (the CLI's
-    rule): a default would give a plausible but wrong image."""
-    projection = camera.get("projection", "lens")
-    if projection == "intrinsics":
-        return ["type", "intrinsics"]
-    if projection == "matrix":
-        return ["projection_matrix"]
-    lens_keys = ["type", "sensor_fit", "shift_x", "shift_y"]
-    if camera.get("type") == "ORTHO":
-        return lens_keys + ["ortho_scale"]
-    side = "sensor_height" if camera.get("sensor_fit") == "VERTICAL" else "sensor_width"
-    return lens_keys + ["lens", side]
-
-
-def _camera_number(key, value):
-    if isinstance(value, bool) or not isinstance(value, numbers.Real):
-        raise SSAOError(f"camera key '{key}' must be a number, got {type(value).__name__}")
     try:
-        number = float(value)
-    except OverflowError:
-        number = math.inf
-    if not math.isfinite(number):
-        raise SSAOError(f"camera key '{key}' must be a finite number, got {value}")
-    return number
+        return json.dumps({str(k): plain(v, k) for k, v in camera.items()})
+    except (TypeError, ValueError) as error:
+        raise SSAOError(f"camera: {error}") from None
 
 
-def _camera_matrix(key, value):
-    import numpy as np
-    shape = _CAMERA_MATRICES[key]
-    rows = "an array of 4 numbers" if shape == (4,) else "a 4x4 matrix (4 rows of 4 numbers)"
-    try:
-        matrix = np.array(value, dtype=object)
-    except ValueError:  # ragged nesting
-        matrix = None
-    if matrix is None or matrix.shape != shape:
-        raise SSAOError(f"camera key '{key}' must be {rows}")
-    # Numbers only, as in the file (np.array(..., float) would take "1" and True).
-    matrix = np.array([_camera_number(key, v) for v in matrix.ravel()]).reshape(shape)
-    if key == "matrix_world" and list(matrix[3]) != [0.0, 0.0, 0.0, 1.0]:
-        raise SSAOError("camera key 'matrix_world' must be an affine transform: its last row "
-                        "must be [0, 0, 0, 1]")
-    return [float(v) for v in matrix.ravel()]
+def _apply_camera(job, camera, stacklevel):
+    """Sets the job's camera from a camera file's dict, warning about the keys the format does
+    not know."""
+    for key in job.set_camera_json(_camera_text(camera)):
+        warnings.warn(f"camera: unknown key '{key}' ignored", stacklevel=stacklevel + 1)
 
 
 def read_camera(path):
@@ -130,34 +102,15 @@ def read_camera(path):
 
 
 def camera_parameters(camera):
-    """The library parameters (name -> value) of a camera file's dict, checked as `ssao --camera`
-    checks the file: SSAOError for a missing key the projection needs, a value of the wrong
-    type or not finite; a key the format does not know is warned about and ignored.
-    "ao_distance" is not among them (ambient_occlusion() uses it as the default radius)."""
-    if not isinstance(camera, dict):
-        raise SSAOError(f"camera must be a dict (a camera file's keys) or a camera file's "
-                        f"path, got {type(camera).__name__}")
-    known = _camera_keys()
-    for key in camera:
-        if key not in known and key not in _CAMERA_ONLY:
-            warnings.warn(f"camera: unknown key '{key}' ignored", stacklevel=3)
-    for key in _required_camera_keys(camera):
-        if key not in camera:
-            raise SSAOError(f"camera: missing key '{key}', which its projection needs "
-                            "(scripts/blender/export_cameras.py writes every key)")
-    params = {}
-    for key, value in camera.items():
-        if key in _CAMERA_POSITIVE and not _camera_number(key, value) > 0.0:
-            raise SSAOError(f"camera key '{key}' must be positive, got {value}")
-        if key in _CAMERA_NOT_NEGATIVE and _camera_number(key, value) < 0.0:
-            raise SSAOError(f"camera key '{key}' must not be negative, got {value}")
-        if key in _CAMERA_ONLY:
-            continue
-        if key in _CAMERA_MATRICES:
-            params[known[key]] = _camera_matrix(key, value)
-        elif key in known:
-            params[known[key]] = value  # Job.set checks the type, the library the value
-    return params
+    """The library parameters (name -> value) of a camera file's dict, checked by the library's
+    reader of the format as `ssao --camera` checks the file: SSAOError for a missing key the
+    projection needs, a value of the wrong type or not finite; a key the format does not know
+    is warned about and ignored. "ao_distance" is not among them (ambient_occlusion() uses it
+    as the default radius)."""
+    with Job(library()) as job:
+        _apply_camera(job, camera, stacklevel=2)
+        return {p["name"]: job.get(p["name"]) for p in parameters()
+                if p["group"] == "camera" and job.is_set(p["name"])}
 
 
 def _set_all(job, settings, what):
@@ -234,11 +187,11 @@ def ambient_occlusion(depth, *, normals=None, camera, depth_layers=(), facing_la
 
     if isinstance(camera, (str, os.PathLike)):
         camera = read_camera(camera)
-    settings = camera_parameters(camera) if camera is not None else {}
     ao = np.empty(frame, np.float32)
     composite = np.empty(beauty.shape, np.float32) if beauty is not None else None
     with Job(library()) as job:
-        _set_all(job, settings, "camera: ")
+        if camera is not None:
+            _apply_camera(job, camera, stacklevel=2)
         _set_all(job, parameters, "")  # after the camera: an argument overrides the file
         job.set_image("depth", depth)
         if normals is not None:
@@ -255,9 +208,11 @@ def ambient_occlusion(depth, *, normals=None, camera, depth_layers=(), facing_la
             if ambient is not None:
                 job.set_image("ambient", ambient)
             job.set_image("composite", composite)
-        _require_matrix_world(job, normals, camera, parameters)
-        if "radius" not in parameters:
-            job.set("radius", _default_radius(job, camera))
+        job.check_inputs()  # world-space normals without the camera's matrix
+        try:  # without radius: the camera's "ao_distance", else the automatic radius
+            job.choose_radius()
+        except SSAOError:
+            raise SSAOError(_NO_GEOMETRY) from None
         job.run(progress)
         if job.last_run()[0] == 0:
             raise SSAOError(_NO_GEOMETRY)
@@ -280,28 +235,3 @@ def _window(output_window, shape):
         raise SSAOError(f"output window {width}x{height} at ({x}, {y}) does not fit in the "
                         f"{shape[1]}x{shape[0]} depth image")
     return x, y, width, height
-
-
-def _require_matrix_world(job, normals, camera, parameters):
-    """World-space normals without the camera's matrix would be turned by the identity: a
-    silently wrong AO, so refused (as the CLI refuses it), whether the matrix would come from
-    the camera ("matrix_world") or the parameters ("camera_to_world")."""
-    has_matrix = (camera is not None and "matrix_world" in camera) or \
-        "camera_to_world" in parameters
-    if normals is None or has_matrix or job.get("normal_space") != "world":
-        return
-    raise SSAOError("missing the camera's matrix ('matrix_world' of the camera, or the "
-                    "parameter camera_to_world), which world-space normals need; add it, or "
-                    "pass normal_space='camera' for view-space normals, or normals=None to "
-                    "rebuild them from depth")
-
-
-def _default_radius(job, camera):
-    """The CLI's rule without --radius: the camera's ao_distance, else the library's automatic
-    radius (10% of the view's width at the median depth)."""
-    if camera is not None and "ao_distance" in camera:
-        return float(camera["ao_distance"])
-    try:
-        return job.auto_radius()
-    except SSAOError:
-        raise SSAOError(_NO_GEOMETRY) from None

@@ -161,6 +161,14 @@ def _declare(lib):
     if hasattr(lib, "ssao_job_last_run"):  # since 0.1 after issue 23
         sig("ssao_job_last_run", c_int, job, ctypes.POINTER(ctypes.c_size_t),
             ctypes.POINTER(c_double))
+    if hasattr(lib, "ssao_job_set_camera_json"):  # since 0.1 after issue 35
+        # Their messages carry their own context (the camera file, the key): raised as they are.
+        sig("ssao_job_set_camera_json", c_int, job, cstr, cstr, checked=False)
+        sig("ssao_job_camera_unknown_keys", c_int, job, ctypes.c_char_p, ctypes.c_size_t)
+        sig("ssao_job_is_set", c_int, job, cstr, ctypes.POINTER(c_int))
+        sig("ssao_job_choose_radius", c_int, job, c_int, ctypes.POINTER(c_double),
+            ctypes.POINTER(c_int), checked=False)
+        sig("ssao_job_check_inputs", c_int, job, checked=False)
 
 
 OUTPUT_IMAGES = ("ao", "composite")
@@ -357,6 +365,44 @@ class Job:
         radius = ctypes.c_double()
         self._lib.ssao_job_auto_radius(self._job, ctypes.byref(radius))
         return radius.value
+
+    def _raise_unless_ok(self, status):
+        if status != 0:
+            raise SSAOError(self._lib.ssao_last_error().decode("utf-8", "replace"))
+
+    def set_camera_json(self, text, source="camera"):
+        """Sets the camera from a camera file's text (ssao_job_set_camera_json: the format's one
+        reader, which the CLI calls too); SSAOError naming `source` and the key, the job then
+        unchanged. Returns the keys the format does not know (ignored)."""
+        if not isinstance(text, str):
+            raise SSAOError(f"camera file text must be a str, got {type(text).__name__}")
+        if "\0" in text:
+            raise SSAOError(f"camera file '{source}': malformed JSON: it holds a NUL character")
+        self._raise_unless_ok(self._lib.ssao_job_set_camera_json(self._job, text.encode(),
+                                                                 str(source).encode()))
+        keys = ctypes.create_string_buffer(4096)
+        self._lib.ssao_job_camera_unknown_keys(self._job, keys, len(keys))
+        return [key for key in keys.value.decode().split(",") if key]
+
+    def is_set(self, name):
+        """True if a set() or a camera file gave the parameter its value (ssao_job_is_set)."""
+        value = ctypes.c_int()
+        self._lib.ssao_job_is_set(self._job, name.encode(), ctypes.byref(value))
+        return bool(value.value)
+
+    def choose_radius(self, allow_automatic=True):
+        """The radius rule without a radius set (ssao_job_choose_radius): a radius set stays;
+        else the camera file's "ao_distance"; else the automatic radius. Returns (radius,
+        source), source one of "set", "camera_file", "automatic"."""
+        radius, source = ctypes.c_double(), ctypes.c_int()
+        self._raise_unless_ok(self._lib.ssao_job_choose_radius(
+            self._job, int(bool(allow_automatic)), ctypes.byref(radius), ctypes.byref(source)))
+        return radius.value, ("set", "camera_file", "automatic")[source.value]
+
+    def check_inputs(self):
+        """SSAOError for what a run would get wrong without a word: world-space normals without
+        the camera's matrix (ssao_job_check_inputs)."""
+        self._raise_unless_ok(self._lib.ssao_job_check_inputs(self._job))
 
     def set_image(self, name, array):
         """Attaches a float32 numpy array (H, W) or (H, W, C), read (or, for the outputs "ao" and
