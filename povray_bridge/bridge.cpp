@@ -29,6 +29,33 @@ namespace {
 namespace fs = std::filesystem;
 using ssao_tools::InterruptGuard;
 
+// What the stages take of the command line.
+OutputFiles output_files(const Options& o) { return {o.output, o.exr}; }
+
+PovrayArguments povray_arguments(const Options& o) { return {o.ini, o.povray_options}; }
+
+PassRunnerSettings pass_runner_settings(const Options& o) {
+  return {o.povray, povray_arguments(o), !o.keep.empty()};
+}
+
+PassChoices pass_choices(const Options& o) {
+  return {o.depth_only, o.apply_to, o.no_normals, o.fog_distances};
+}
+
+RenderRequest render_request(const Options& o) {
+  RenderRequest request;
+  request.scene = o.scene;
+  request.width = o.width;
+  request.height = o.height;
+  request.povray_arguments = povray_arguments(o);
+  request.outputs = output_files(o);
+  request.print_camera = o.print_camera;
+  request.keep = o.keep;
+  request.overscan = o.overscan;
+  request.depth_only = o.depth_only;
+  return request;
+}
+
 // The beauty and the ambient pass keep the scene's own camera when it has focal blur: POV-Ray
 // blurs them as the user asked, while the depth and normal passes, rendered with the resolved
 // camera, stay sharp (a blurred depth would mix distances). Camera flags replace the camera.
@@ -74,9 +101,11 @@ void render_image(const Options& o, const RenderSetup& setup, const AnimationFra
       throw ssao_tools::Error("--keep: cannot create the folder " + in_quotes(o.keep));
     }
   }
-  const ImageScene scene = read_image_scene(o, setup, frame, report);
+  const PassRunnerSettings povray_settings = pass_runner_settings(o);
+  const ImageScene scene =
+      read_image_scene(o.camera, o.print_camera, povray_settings, setup, frame, report);
   const CameraReading& reading = scene.reading;
-  const int band = guard_band(o, width, height);
+  const int band = guard_band(o.overscan, o.depth_only, width, height);
   if (o.print_camera) {
     for (const std::string& note : scene.scan.notes) report.warning(note);
     for (const std::string& warning : reading.warnings) report.warning(warning);
@@ -86,14 +115,14 @@ void render_image(const Options& o, const RenderSetup& setup, const AnimationFra
   report_camera(o, scene, width, height, report);
 
   ScratchFolder scratch;
-  const PassRunner povray = make_pass_runner(o, setup, frame, scratch);
+  const PassRunner povray = make_pass_runner(povray_settings, setup, frame, scratch);
   KeepFiles keep(scratch, o.keep, report);
   // The data passes libssao reads (depth, normals) see a band around the frame: occluders just
   // outside it darken its edges. The beauty and the ambient pass are the frame.
   write_wrappers(scratch.path(), setup.scene_name,
                  scene_camera_for_frame(o, reading) ? nullptr : &reading.camera,
                  band > 0 ? reading.camera.widened(width, height, band) : reading.camera);
-  ImagePasses passes(o, povray, scene, width, height, band, report);
+  ImagePasses passes(pass_choices(o), povray, scene, width, height, band, report);
   passes.start();
 
   AoInputs in;
@@ -103,7 +132,7 @@ void render_image(const Options& o, const RenderSetup& setup, const AnimationFra
   in.camera = reading.camera;
   passes.finish_depth(in);
   if (o.depth_only) {
-    write_depth_only(o, in);
+    write_depth_only(o.output, in);
     const PassTimings t = passes.timings();
     if (t.prepass > 0.0) {
       report.progress("wrote %s (Z, Radial) in %.2f s: pre-pass %.2f s, depth %.2f s",
@@ -118,7 +147,7 @@ void render_image(const Options& o, const RenderSetup& setup, const AnimationFra
   passes.finish_ambient(in);
   passes.finish_normals(in);
 
-  const double ao_seconds = compute_and_write(o, in, report);
+  const double ao_seconds = compute_and_write(o.params, output_files(o), in, report);
   const std::string written = o.output + (o.exr.empty() ? "" : " and " + o.exr);
   report.progress("wrote %s in %.2f s (passes at once: %s; AO %.2f s)", written.c_str(),
                   seconds_since(start), describe(passes.timings()).c_str(), ao_seconds);
@@ -226,7 +255,7 @@ std::string depth_channel(const Options& o, const ssao_tools::Image& depth) {
 void run_render(const Options& o) {
   InterruptGuard interrupt_guard;
   const Reporter report(o.quiet);
-  const RenderSetup setup = prepare_render(o);
+  const RenderSetup setup = prepare_render(render_request(o));
   const std::vector<AnimationFrame> frames = animation_frames(setup.clock);
   if (!frames.empty() && !o.param("radius") && !o.depth_only && !o.print_camera) {
     throw UsageError(
@@ -270,7 +299,7 @@ void run_post_process(const Options& o) {
   fill_planar_and_radial(in, depth, depth_is_planar);
   report.progress("%dx%d, depth channel %s (%s), camera %s", in.width, in.height, channel.c_str(),
                   depth_is_planar ? "planar" : "radial", in.camera.summary().c_str());
-  compute_and_write(o, in, report);
+  compute_and_write(o.params, output_files(o), in, report);
   report.progress("wrote %s%s in %.2f s", o.output.c_str(),
                   o.exr.empty() ? "" : (" and " + o.exr).c_str(), seconds_since(start));
 }

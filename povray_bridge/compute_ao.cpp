@@ -30,12 +30,12 @@ struct JobImages {
 // The camera, the depth kind and the user's parameters; the inputs and outputs. With a guard
 // band, depth and normals are larger than the frame: the outputs are the window at (band,
 // band), and the camera is the frame's, as libssao wants it.
-void set_up_job(ssao::api::Job& job, const Options& o, AoInputs& in, bool gamma,
-                JobImages& images) {
+void set_up_job(ssao::api::Job& job, const std::vector<ssao_tools::ParamSetting>& params,
+                AoInputs& in, bool gamma, JobImages& images) {
   in.camera.apply_to_job(job, in.width, in.height);
   job.set("depth_kind", in.planar_input ? "planar" : "radial");
   if (!in.normals.empty()) job.set("normal_space", "camera");
-  ssao_tools::apply_params(job, o.params);
+  ssao_tools::apply_params(job, params);
 
   images.ao.assign(in.frame_pixels(), 1.0f);
   images.composite.assign(in.frame_pixels() * 4, 0.0f);
@@ -69,13 +69,14 @@ void choose_default_radius(ssao::api::Job& job, const AoInputs& in, const Report
 
 }  // namespace
 
-double compute_and_write(const Options& o, AoInputs& in, const Reporter& report) {
+double compute_and_write(const std::vector<ssao_tools::ParamSetting>& params,
+                         const OutputFiles& files, AoInputs& in, const Reporter& report) {
   // In ambient mode the composite is made in the scene's working space, where the ambient term
   // adds to the rest of the light: beauty^(1/gamma) - (1 - AO) ambient, then ^gamma again.
   const bool gamma = !in.ambient.empty() && in.working_gamma != 1.0;
   ssao::api::Job job;
   JobImages images;
-  set_up_job(job, o, in, gamma, images);
+  set_up_job(job, params, in, gamma, images);
   choose_default_radius(job, in, report);
 
   report.begin("AO (%s, normals %s, %s)... ", job.settings_summary().c_str(),
@@ -93,7 +94,7 @@ double compute_and_write(const Options& o, AoInputs& in, const Reporter& report)
   const ssao::api::Job::RunStats stats = job.last_run();  // the library's background rule
   report.end("%.2f s, mean AO %.3f over %zu geometry pixels", seconds, stats.mean_ao,
              stats.geometry_pixels);
-  write_outputs(o, in, images.composite, images.ao);
+  write_outputs(files, in, images.composite, images.ao);
   return seconds;
 }
 

@@ -3,14 +3,19 @@
 // its guard band), normals, beauty and ambient term, then the output files.
 #pragma once
 
+#include <vector>
+
 #include "ao_inputs.h"
-#include "options.h"
+#include "outputs.h"
 #include "reporter.h"
+#include "tools/param_flags.h"
 
 namespace povray_ssao {
 
-// Runs libssao and writes the outputs (-o, --exr); returns the seconds spent in ssao_job_run.
-// Throws ssao_tools::Error when interrupted or when the library fails; nothing is written then.
-double compute_and_write(const Options& o, AoInputs& in, const Reporter& report);
+// Runs libssao with the user's `params` (in command-line order) and writes `files`; returns the
+// seconds spent in ssao_job_run. Throws ssao_tools::Error when interrupted or when the library
+// fails; nothing is written then.
+double compute_and_write(const std::vector<ssao_tools::ParamSetting>& params,
+                         const OutputFiles& files, AoInputs& in, const Reporter& report);
 
 }  // namespace povray_ssao

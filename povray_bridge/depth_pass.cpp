@@ -33,8 +33,8 @@ std::vector<std::string> depth_pass_options(const FogDistances& fogs, const Scen
 }
 
 void DepthPass::choose_fogs() {
-  if (o_.fog_distances) {
-    distances_ = *o_.fog_distances;
+  if (given_distances_) {
+    distances_ = *given_distances_;
   } else if (camera_.look_at_distance > 0.0 && !camera_.orthographic) {
     distances_ = camera_distances(camera_.look_at_distance);
     guessed_ = true;
@@ -102,7 +102,7 @@ void DepthPass::check_usable(const DepthStats& errors) const {
       "most often a plane whose normal points away from the camera (plane { z, 10 } "
       "behind the scene puts the camera inside it): add 'hollow' to that object (the "
       "render does not change) or turn its normal towards the camera" +
-      (o_.fog_distances ? "; or choose --fog-distances near the scene's depths" : ""));
+      (given_distances_ ? "; or choose --fog-distances near the scene's depths" : ""));
 }
 
 std::vector<float> DepthPass::finish() {

@@ -4,9 +4,10 @@
 // render when the look_at guess missed the scene's depths; a refusal when no fog reached it).
 #pragma once
 
+#include <optional>
+#include <string>
 #include <vector>
 
-#include "options.h"
 #include "pass_runner.h"
 #include "passes.h"
 #include "reporter.h"
@@ -16,11 +17,12 @@ namespace povray_ssao {
 
 class DepthPass {
  public:
-  // `data_camera` is the camera the pass is rendered with (widened for a guard band), at
-  // data_width x data_height.
-  DepthPass(const Options& o, const PassRunner& povray, const SceneScan& scan,
-            const ResolvedCamera& camera, int data_width, int data_height, const Reporter& report)
-      : o_(o),
+  // `given_distances`: --fog-distances. The pass is rendered at data_width x data_height (the
+  // frame and its guard band); `camera` is the frame's.
+  DepthPass(const std::optional<FogDistances>& given_distances, const PassRunner& povray,
+            const SceneScan& scan, const ResolvedCamera& camera, int data_width, int data_height,
+            const Reporter& report)
+      : given_distances_(given_distances),
         povray_(povray),
         scan_(scan),
         camera_(camera),
@@ -46,7 +48,7 @@ class DepthPass {
   void report_depths(const DepthStats& depths, const DepthStats& errors) const;
   void check_usable(const DepthStats& errors) const;
 
-  const Options& o_;
+  const std::optional<FogDistances> given_distances_;
   const PassRunner& povray_;
   const SceneScan& scan_;
   const ResolvedCamera& camera_;

@@ -12,7 +12,8 @@ namespace {
 std::vector<std::string> full_channel_names() { return {"R", "G", "B", "A", "AO", "Z", "Radial"}; }
 
 // The 8-bit preview: the composite's R, G, B (and A when the beauty had alpha).
-void write_preview(const Options& o, const AoInputs& in, const std::vector<float>& composite) {
+void write_preview(const std::string& path, const AoInputs& in,
+                   const std::vector<float>& composite) {
   const size_t count = in.frame_pixels();
   const size_t channels = in.beauty_has_alpha ? 4 : 3;
   std::vector<float> preview(count * channels);
@@ -21,13 +22,13 @@ void write_preview(const Options& o, const AoInputs& in, const std::vector<float
   }
   std::vector<std::string> names = {"R", "G", "B", "A"};
   names.resize(channels);
-  ssao_tools::write_preview(o.output, in.width, in.height, names, preview);
+  ssao_tools::write_preview(path, in.width, in.height, names, preview);
 }
 
 }  // namespace
 
-void write_outputs(const Options& o, const AoInputs& in, const std::vector<float>& composite,
-                   const std::vector<float>& ao) {
+void write_outputs(const OutputFiles& files, const AoInputs& in,
+                   const std::vector<float>& composite, const std::vector<float>& ao) {
   const size_t count = in.frame_pixels();
   std::vector<float> full(count * 7);
   for (size_t p = 0; p < count; ++p) {
@@ -37,34 +38,34 @@ void write_outputs(const Options& o, const AoInputs& in, const std::vector<float
     full[p * 7 + 6] = in.radial[p];
   }
   auto write_main = [&]() {
-    if (ssao_tools::is_preview_path(o.output)) {
-      write_preview(o, in, composite);
+    if (ssao_tools::is_preview_path(files.output)) {
+      write_preview(files.output, in, composite);
     } else {
-      ssao_tools::write_exr(o.output, in.width, in.height, full_channel_names(), full);
+      ssao_tools::write_exr(files.output, in.width, in.height, full_channel_names(), full);
     }
   };
-  if (o.exr.empty()) {
+  if (files.exr.empty()) {
     write_main();
     return;
   }
-  ssao_tools::write_exr(o.exr, in.width, in.height, full_channel_names(), full);
+  ssao_tools::write_exr(files.exr, in.width, in.height, full_channel_names(), full);
   try {
     write_main();
   } catch (...) {
     std::error_code ec;
-    std::filesystem::remove(o.exr, ec);
+    std::filesystem::remove(files.exr, ec);
     throw;
   }
 }
 
-void write_depth_only(const Options& o, const AoInputs& in) {
+void write_depth_only(const std::string& output, const AoInputs& in) {
   const size_t count = in.frame_pixels();
   std::vector<float> pixels(count * 2);
   for (size_t p = 0; p < count; ++p) {
     pixels[p * 2] = in.planar[p];
     pixels[p * 2 + 1] = in.radial[p];
   }
-  ssao_tools::write_exr(o.output, in.width, in.height, {"Z", "Radial"}, pixels);
+  ssao_tools::write_exr(output, in.width, in.height, {"Z", "Radial"}, pixels);
 }
 
 void print_camera(const CameraReading& reading, bool scene_camera_for_frame, int width, int height,

@@ -25,9 +25,10 @@ std::string describe(const PassTimings& t) {
   return out;
 }
 
-ImagePasses::ImagePasses(const Options& o, const PassRunner& povray, const ImageScene& scene,
-                         int width, int height, int band, const Reporter& report)
-    : o_(o),
+ImagePasses::ImagePasses(const PassChoices& choices, const PassRunner& povray,
+                         const ImageScene& scene, int width, int height, int band,
+                         const Reporter& report)
+    : choices_(choices),
       povray_(povray),
       scan_(scene.scan),
       camera_(scene.reading.camera),
@@ -35,12 +36,12 @@ ImagePasses::ImagePasses(const Options& o, const PassRunner& povray, const Image
       height_(height),
       band_(band),
       report_(report),
-      depth_(o, povray, scene.scan, scene.reading.camera, width + 2 * band, height + 2 * band,
-             report) {}
+      depth_(choices.fog_distances, povray, scene.scan, scene.reading.camera, width + 2 * band,
+             height + 2 * band, report) {}
 
 // What AO darkens: the ambient term when the scene has one that can be rendered apart.
 bool ImagePasses::wants_ambient_pass() const {
-  if (o_.depth_only || o_.apply_to == "beauty") return false;
+  if (choices_.depth_only || choices_.apply_to == "beauty") return false;
   std::string why_not;
   if (scan_.uses_radiosity && (scan_.version == 0.0 || scan_.version >= 3.7)) {
     why_not =
@@ -51,7 +52,7 @@ bool ImagePasses::wants_ambient_pass() const {
         "povray-ssao cannot read the scene's ambient_light (" + scan_.ambient_light_problem + ")";
   }
   if (why_not.empty()) return true;
-  if (o_.apply_to == "ambient") throw ssao_tools::Error("--apply-to ambient: " + why_not);
+  if (choices_.apply_to == "ambient") throw ssao_tools::Error("--apply-to ambient: " + why_not);
   report_.progress("AO darkens the whole image: %s", why_not.c_str());
   return false;
 }
@@ -78,7 +79,7 @@ void ImagePasses::start_normal_pass() {
 
 void ImagePasses::start() {
   ambient_pass_ = wants_ambient_pass();
-  if (!o_.depth_only) {
+  if (!choices_.depth_only) {
     beauty_ = povray_.start("beauty", "beauty", "beauty.pov", width_, height_, {});
   }
   if (ambient_pass_) {
@@ -86,7 +87,9 @@ void ImagePasses::start() {
     ambient_ = povray_.start("ambient pass", "ambient", "ambient.pov", width_, height_,
                              {scan_.uses_quick_color ? "+Q6" : "+Q3", "-A", "-UA"});
   }
-  if (!o_.depth_only && scan_.includes_ssao_passes && !o_.no_normals) start_normal_pass();
+  if (!choices_.depth_only && scan_.includes_ssao_passes && !choices_.no_normals) {
+    start_normal_pass();
+  }
   depth_.choose_fogs();
   depth_.start();
   const bool normals = normals_.process != nullptr;
@@ -98,11 +101,11 @@ void ImagePasses::start() {
         height_);
   }
   report_.progress("rendering %s (%dx%d) at once...",
-                   o_.depth_only   ? "the depth pass"
-                   : ambient_pass_ ? (normals ? "the beauty, depth, ambient and normal passes"
-                                              : "the beauty, depth and ambient passes")
-                   : normals       ? "the beauty, depth and normal passes"
-                                   : "the beauty and the depth pass",
+                   choices_.depth_only ? "the depth pass"
+                   : ambient_pass_     ? (normals ? "the beauty, depth, ambient and normal passes"
+                                                  : "the beauty, depth and ambient passes")
+                   : normals           ? "the beauty, depth and normal passes"
+                                       : "the beauty and the depth pass",
                    width_, height_);
   // The image file module (OpenImageIO) loads while POV-Ray renders.
   ssao_tools::preload_image_io();
@@ -173,7 +176,7 @@ void ImagePasses::report_ambient_share(AoInputs& in, const V3& light, double sha
                     "ambient x pigment above 6.5); AO leaves them unchanged");
   }
   if (share >= 0.01) return;
-  if (o_.apply_to == "ambient") {
+  if (choices_.apply_to == "ambient") {
     report_.warning("the scene has almost no ambient light: AO changes little");
   } else {
     report_.progress(

@@ -4,12 +4,13 @@
 // that include ssao_passes.inc); each finished pass fills its part of the AO step's inputs.
 #pragma once
 
+#include <optional>
 #include <string>
 
 #include "ao_inputs.h"
 #include "depth_pass.h"
-#include "options.h"
 #include "pass_runner.h"
+#include "passes.h"
 #include "reporter.h"
 #include "scene_setup.h"
 
@@ -23,11 +24,19 @@ struct PassTimings {
 // "beauty 1.20 s, depth 0.80 s, ambient 0.55 s": the passes rendered.
 std::string describe(const PassTimings& timings);
 
+// What the command line decides about an image's passes.
+struct PassChoices {
+  bool depth_only = false;  // --depth-only: the depth pass alone
+  std::string apply_to;     // --apply-to: auto | ambient | beauty (whether the ambient pass)
+  bool no_normals = false;  // --no-normals: no normal pass even where the scene has one
+  std::optional<FogDistances> fog_distances;  // --fog-distances
+};
+
 class ImagePasses {
  public:
   // The wrappers (passes.h: write_wrappers) must be in the runner's scratch folder.
-  ImagePasses(const Options& o, const PassRunner& povray, const ImageScene& scene, int width,
-              int height, int band, const Reporter& report);
+  ImagePasses(const PassChoices& choices, const PassRunner& povray, const ImageScene& scene,
+              int width, int height, int band, const Reporter& report);
 
   // Decides whether the ambient pass is rendered and starts every pass (after the depth
   // pre-pass, when the fogs need one): POV-Ray spends about 0.65 s of each run waiting
@@ -49,7 +58,7 @@ class ImagePasses {
   ssao_tools::Image read_frame_pass(const RunningPass& pass, const char* hint) const;
   void report_ambient_share(AoInputs& in, const V3& light, double share, size_t overflowed) const;
 
-  const Options& o_;
+  const PassChoices choices_;
   const PassRunner& povray_;
   const SceneScan& scan_;
   const ResolvedCamera& camera_;

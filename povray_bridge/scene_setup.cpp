@@ -6,6 +6,7 @@
 #include <cstdlib>
 #include <vector>
 
+#include "options.h"  // default_guard_band
 #include "povray_run.h"
 #include "scene_check.h"
 #include "tools/files.h"
@@ -43,47 +44,50 @@ std::string include_folder() {
 }
 
 // The scene must be a readable file.
-void check_scene(const Options& o) {
+void check_scene(const std::string& scene) {
   std::error_code ec;
-  if (!fs::exists(o.scene, ec)) throw ssao_tools::Error("no scene file " + in_quotes(o.scene));
-  if (!fs::is_regular_file(o.scene, ec)) {
-    throw ssao_tools::Error("the scene " + in_quotes(o.scene) + " is not a file");
+  if (!fs::exists(scene, ec)) throw ssao_tools::Error("no scene file " + in_quotes(scene));
+  if (!fs::is_regular_file(scene, ec)) {
+    throw ssao_tools::Error("the scene " + in_quotes(scene) + " is not a file");
   }
-  if (::access(o.scene.c_str(), R_OK) != 0) {
-    throw ssao_tools::Error("cannot read the scene file " + in_quotes(o.scene));
+  if (::access(scene.c_str(), R_OK) != 0) {
+    throw ssao_tools::Error("cannot read the scene file " + in_quotes(scene));
   }
 }
 
 // The outputs, --ini and --keep: refused now rather than after the rendering.
-void check_outputs_and_folders(const Options& o) {
+void check_outputs_and_folders(const RenderRequest& r) {
   std::error_code ec;
-  if (!o.print_camera) {
-    ssao_tools::check_output_folder(o.output);
-    if (!o.exr.empty()) ssao_tools::check_output_folder(o.exr);
-    if (ssao_tools::same_file(o.output, o.scene) ||
-        (!o.exr.empty() && ssao_tools::same_file(o.exr, o.scene))) {
+  if (!r.print_camera) {
+    const OutputFiles& out = r.outputs;
+    ssao_tools::check_output_folder(out.output);
+    if (!out.exr.empty()) ssao_tools::check_output_folder(out.exr);
+    if (ssao_tools::same_file(out.output, r.scene) ||
+        (!out.exr.empty() && ssao_tools::same_file(out.exr, r.scene))) {
       throw UsageError("the output is the scene file; choose another -o");
     }
   }
-  if (!o.ini.empty() && !fs::is_regular_file(o.ini, ec)) {
-    throw ssao_tools::Error("no INI file " + in_quotes(o.ini));
+  const std::string& ini = r.povray_arguments.ini;
+  if (!ini.empty() && !fs::is_regular_file(ini, ec)) {
+    throw ssao_tools::Error("no INI file " + in_quotes(ini));
   }
-  if (!o.keep.empty()) {
-    fs::create_directories(o.keep, ec);
-    if (!fs::is_directory(o.keep, ec)) {
-      throw ssao_tools::Error("--keep: cannot create the folder " + in_quotes(o.keep));
+  if (!r.keep.empty()) {
+    fs::create_directories(r.keep, ec);
+    if (!fs::is_directory(r.keep, ec)) {
+      throw ssao_tools::Error("--keep: cannot create the folder " + in_quotes(r.keep));
     }
   }
 }
 
 // The size POV-Ray will render: the command line's, else the INI file's, else povray.ini's, else
 // its built-in 160x120. Throws when it is over povray-ssao's limit.
-void frame_size(const Options& o, const std::string& scene_folder, int& width, int& height) {
-  width = o.width;
-  height = o.height;
-  if (!o.ini.empty() && (width == 0 || height == 0)) {
+void frame_size(const RenderRequest& r, const std::string& scene_folder, int& width, int& height) {
+  width = r.width;
+  height = r.height;
+  const std::string& ini = r.povray_arguments.ini;
+  if (!ini.empty() && (width == 0 || height == 0)) {
     int w = 0, h = 0;
-    ini_size(o.ini, w, h);
+    ini_size(ini, w, h);
     if (width == 0) width = w;
     if (height == 0) height = h;
   }
@@ -97,13 +101,13 @@ void frame_size(const Options& o, const std::string& scene_folder, int& width, i
 
 // Where POV-Ray looks for include files, in its order: povray.ini's and --ini's Library_Path,
 // the command line's +L, the scene's folder, povray-ssao's includes (relative to the scene).
-std::vector<std::string> library_paths(const Options& o, const std::string& startup_ini,
+std::vector<std::string> library_paths(const PovrayArguments& user, const std::string& startup_ini,
                                        const std::string& scene_folder,
                                        const std::string& includes) {
   std::vector<std::string> paths;
   if (!startup_ini.empty()) ini_library_paths(startup_ini, paths);
-  if (!o.ini.empty()) ini_library_paths(o.ini, paths);
-  for (const std::string& option : o.povray_options) {
+  if (!user.ini.empty()) ini_library_paths(user.ini, paths);
+  for (const std::string& option : user.options) {
     if (option.size() > 2 && (option[1] == 'L' || option[1] == 'l')) {
       paths.push_back(option.substr(2));
     } else if (option.size() > 13 &&
@@ -121,11 +125,12 @@ std::vector<std::string> library_paths(const Options& o, const std::string& star
 
 // The Declare=NAME=VALUE settings of povray.ini, --ini and the command line, as the numbers the
 // scan knows (POV-Ray's Declare= takes floats only); reads the clock options on the way.
-Symbols declared_values(const Options& o, const std::string& startup_ini, ClockOptions& clock) {
+Symbols declared_values(const PovrayArguments& user, const std::string& startup_ini,
+                        ClockOptions& clock) {
   std::vector<std::string> declares;
   if (!startup_ini.empty()) ini_declares(startup_ini, declares, clock);
-  if (!o.ini.empty()) ini_declares(o.ini, declares, clock);
-  option_declares(o.povray_options, declares, clock);
+  if (!user.ini.empty()) ini_declares(user.ini, declares, clock);
+  option_declares(user.options, declares, clock);
   Symbols symbols;
   for (const std::string& declare : declares) {
     const size_t equals = declare.find('=');
@@ -143,10 +148,10 @@ Symbols declared_values(const Options& o, const std::string& startup_ini, ClockO
 
 }  // namespace
 
-RenderSetup prepare_render(const Options& o) {
-  check_scene(o);
+RenderSetup prepare_render(const RenderRequest& request) {
+  check_scene(request.scene);
   RenderSetup setup;
-  setup.scene_path = fs::absolute(o.scene).lexically_normal();
+  setup.scene_path = fs::absolute(request.scene).lexically_normal();
   setup.scene_folder = setup.scene_path.parent_path().string();
   setup.scene_name = setup.scene_path.filename().string();
   if (setup.scene_name.find('"') != std::string::npos) {
@@ -154,38 +159,40 @@ RenderSetup prepare_render(const Options& o) {
         "the scene's file name contains '\"', which POV-Ray's #include cannot "
         "take");
   }
-  check_outputs_and_folders(o);
-  frame_size(o, setup.scene_folder, setup.width, setup.height);
-  guard_band(o, setup.width, setup.height);  // a band too large is every frame's mistake
+  check_outputs_and_folders(request);
+  frame_size(request, setup.scene_folder, setup.width, setup.height);
+  // A band too large is every frame's mistake.
+  guard_band(request.overscan, request.depth_only, setup.width, setup.height);
 
   // The camera is read from the scene text and its include files, found as POV-Ray finds them.
   setup.includes = include_folder();
   const std::string startup_ini = system_ini(setup.scene_folder);
   ScanSettings& settings = setup.settings;
   settings.directory = setup.scene_folder;
-  settings.library_paths = library_paths(o, startup_ini, setup.scene_folder, setup.includes);
+  settings.library_paths =
+      library_paths(request.povray_arguments, startup_ini, setup.scene_folder, setup.includes);
   settings.image_width = setup.width;
   settings.image_height = setup.height;
-  settings.predeclared = declared_values(o, startup_ini, setup.clock);
+  settings.predeclared = declared_values(request.povray_arguments, startup_ini, setup.clock);
   settings.clock = setup.clock.clock;
   return setup;
 }
 
-int guard_band(const Options& o, int width, int height) {
-  if (o.depth_only) return 0;
+int guard_band(const std::optional<int>& overscan, bool depth_only, int width, int height) {
+  if (depth_only) return 0;
   auto fits = [&](int band) {
     const long long data_width = static_cast<long long>(width) + 2LL * band;
     const long long data_height = static_cast<long long>(height) + 2LL * band;
     return band >= 0 && data_width <= kMaxSide && data_height <= kMaxSide &&
            double(data_width) * double(data_height) <= kMaxPixels;
   };
-  if (!o.overscan) {
+  if (!overscan) {
     // The default shrinks near the size limits rather than refusing a frame that fits.
     int band = default_guard_band(width, height);
     while (band > 0 && !fits(band)) --band;
     return band;
   }
-  const int band = *o.overscan;
+  const int band = *overscan;
   if (!fits(band)) {
     const long long data_width = static_cast<long long>(width) + 2LL * band;
     const long long data_height = static_cast<long long>(height) + 2LL * band;
@@ -198,24 +205,25 @@ int guard_band(const Options& o, int width, int height) {
   return band;
 }
 
-PassRunner make_pass_runner(const Options& o, const RenderSetup& setup, const AnimationFrame* frame,
-                            const ScratchFolder& scratch) {
+PassRunner make_pass_runner(const PassRunnerSettings& settings, const RenderSetup& setup,
+                            const AnimationFrame* frame, const ScratchFolder& scratch) {
+  const PovrayArguments& user = settings.arguments;
   PassRunner povray;
-  povray.executable = find_executable(o.povray);
+  povray.executable = find_executable(settings.executable);
   povray.scene_folder = setup.scene_folder;
   povray.scene_name = setup.scene_name;
   povray.include_folder = setup.includes;
-  if (!o.ini.empty()) povray.user_options.push_back(fs::absolute(o.ini).string());
-  povray.user_options.insert(povray.user_options.end(), o.povray_options.begin(),
-                             o.povray_options.end());
+  if (!user.ini.empty()) povray.user_options.push_back(fs::absolute(user.ini).string());
+  povray.user_options.insert(povray.user_options.end(), user.options.begin(), user.options.end());
   povray.scratch = &scratch;
   povray.frame = frame;
-  povray.keep = !o.keep.empty();
+  povray.keep = settings.keep;
   return povray;
 }
 
-ImageScene read_image_scene(const Options& o, const RenderSetup& setup, const AnimationFrame* frame,
-                            const Reporter& report) {
+ImageScene read_image_scene(const CameraOverrides& camera_flags, bool print_camera,
+                            const PassRunnerSettings& povray, const RenderSetup& setup,
+                            const AnimationFrame* frame, const Reporter& report) {
   ScanSettings settings = setup.settings;
   if (frame) {
     settings.clock = frame->clock;
@@ -224,20 +232,20 @@ ImageScene read_image_scene(const Options& o, const RenderSetup& setup, const An
   ImageScene scene;
   try {
     scene.scan = scan_scene(setup.scene_path.string(), settings);
-    scene.reading = read_camera(scene.scan, o.camera, setup.width, setup.height);
+    scene.reading = read_camera(scene.scan, camera_flags, setup.width, setup.height);
   } catch (const ssao_tools::Error&) {
     // A syntax error often looks like a missing or unreadable camera to the scan: POV-Ray's
     // own message says what is wrong, and where. --print-camera renders nothing.
-    if (!o.print_camera) {
+    if (!print_camera) {
       ScratchFolder scratch;
-      check_scene_parses(make_pass_runner(o, setup, frame, scratch), setup.scene_name, report);
+      check_scene_parses(make_pass_runner(povray, setup, frame, scratch), setup.scene_name, report);
     }
     throw;
   }
-  if (scene.reading.default_camera && !o.camera.any() && !o.print_camera) {
+  if (scene.reading.default_camera && !camera_flags.any() && !print_camera) {
     ScratchFolder scratch;
-    check_default_camera(make_pass_runner(o, setup, frame, scratch), setup.scene_name, scene.scan,
-                         scene.reading.camera, setup.width, setup.height, report);
+    check_default_camera(make_pass_runner(povray, setup, frame, scratch), setup.scene_name,
+                         scene.scan, scene.reading.camera, setup.width, setup.height, report);
   }
   return scene;
 }

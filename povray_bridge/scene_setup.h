@@ -5,10 +5,12 @@
 #pragma once
 
 #include <filesystem>
+#include <optional>
 #include <string>
+#include <vector>
 
 #include "animation.h"
-#include "options.h"
+#include "outputs.h"
 #include "pass_runner.h"
 #include "pov_camera.h"
 #include "reporter.h"
@@ -31,20 +33,47 @@ struct RenderSetup {
   ClockOptions clock;
 };
 
+// --ini and the options passed through to POV-Ray (+X switches, Name=value), in order: the scan
+// reads their Library_Path and Declare= settings, and every povray run gets them.
+struct PovrayArguments {
+  std::string ini;
+  std::vector<std::string> options;
+};
+
+// The render the command line asks for, as prepare_render checks it.
+struct RenderRequest {
+  std::string scene;
+  int width = 0, height = 0;  // 0: not given
+  PovrayArguments povray_arguments;
+  OutputFiles outputs;
+  bool print_camera = false;  // writes no output, so the outputs are not checked
+  std::string keep;           // --keep's folder, or empty
+  std::optional<int> overscan;
+  bool depth_only = false;
+};
+
 // Checks the scene file, the outputs, --ini, --keep and the image size, and gathers what the
 // scan needs: the library paths and Declare= values POV-Ray will see. Throws ssao_tools::Error
 // (UsageError for an output that is the scene) before anything is rendered.
-RenderSetup prepare_render(const Options& o);
+RenderSetup prepare_render(const RenderRequest& request);
 
-// The guard band of the data passes (pixels per side): --overscan, else the default; none for
-// --depth-only (the frame's depth is its output). Throws when --overscan would take the data
-// passes over the size limits.
-int guard_band(const Options& o, int width, int height);
+// The guard band of the data passes (pixels per side): `overscan` (--overscan), else the
+// default; none for --depth-only (the frame's depth is its output). Throws when `overscan`
+// would take the data passes over the size limits.
+int guard_band(const std::optional<int>& overscan, bool depth_only, int width, int height);
+
+// How an image's povray runs are made: the executable (--povray), the user's arguments, and
+// whether --keep copies their files.
+struct PassRunnerSettings {
+  std::string executable;
+  PovrayArguments arguments;
+  bool keep = false;
+};
 
 // The runner of an image's povray runs: in the scene's folder, with the user's --ini and
 // options, an animation frame alone, the files in `scratch`.
-PassRunner make_pass_runner(const Options& o, const RenderSetup& setup, const AnimationFrame* frame,
-                            const ScratchFolder& scratch);
+PassRunner make_pass_runner(const PassRunnerSettings& settings, const RenderSetup& setup,
+                            const AnimationFrame* frame, const ScratchFolder& scratch);
 
 // The scene as one image (a still, or an animation's frame) sees it.
 struct ImageScene {
@@ -52,11 +81,13 @@ struct ImageScene {
   CameraReading reading;
 };
 
-// Scans the scene text at the frame's clock and reads its camera (with the --camera-* flags).
-// Where the text fails (a scan error, an unreadable camera), POV-Ray's parser is asked first,
-// so that a syntax error is reported as POV-Ray reports it; a scene without a camera gets
-// POV-Ray's default camera once POV-Ray is seen to render it with that (scene_check.h).
-ImageScene read_image_scene(const Options& o, const RenderSetup& setup, const AnimationFrame* frame,
-                            const Reporter& report);
+// Scans the scene text at the frame's clock and reads its camera (with `camera_flags`, the
+// --camera-* flags). Where the text fails (a scan error, an unreadable camera), POV-Ray's
+// parser is asked first, so that a syntax error is reported as POV-Ray reports it; a scene
+// without a camera gets POV-Ray's default camera once POV-Ray is seen to render it with that
+// (scene_check.h). With --print-camera (`print_camera`) POV-Ray is not run.
+ImageScene read_image_scene(const CameraOverrides& camera_flags, bool print_camera,
+                            const PassRunnerSettings& povray, const RenderSetup& setup,
+                            const AnimationFrame* frame, const Reporter& report);
 
 }  // namespace povray_ssao
