@@ -296,16 +296,17 @@ def threads(scene):
     return render.threads if render.threads_mode == 'FIXED' else 0
 
 
-def compute_node(node, scene, passes, wait=True):
+def compute_node(node, scene, passes, wait=True, run_stats=None):
     """AO of `node` from exported `passes` (read_export's: normal xyz, depth[, the Image's
     alpha]); fills the node's AO image (with the composite's factor: inner_tree.py) and returns
     the AO with row 0 on top. Raises, leaving the AO image as it was, when the inputs, the
     parameters or the library cannot give this frame's AO. With wait=False (the UI) a helper
     render the node needs is asked of helper_process and, until its layers come, the AO is
-    computed without them (waiting_status())."""
+    computed without them (waiting_status()). run_stats (a dict, optional) gets what the
+    library saw: "geometry_pixels" and their "mean_ao" (ssao.ambient_occlusion's)."""
     use_normals = check_inputs(node)
     check_parameters(node)
-    lib = library()  # before the helper render (library_inputs): a missing library renders none
+    library()  # before the helper render (library_inputs): a missing library renders none
     camera = camera_module.camera_params(scene)
     background = EEVEE_BACKGROUND_DEPTH if compat.is_eevee(scene) else \
         library_default("background_depth")
@@ -315,20 +316,20 @@ def compute_node(node, scene, passes, wait=True):
     rgba, outputs = inner_tree.library_outputs(passes)
     # Blender's rows run bottom-up, the library's top-down: flipped views read in place.
     images, overscan = library_inputs(node, scene, passes, use_normals, wait)
-    with ssao.Job(lib) as job:
-        for name, value in camera.items():
-            job.set(name, value)
-        job.set("background_depth", background)  # the same as the Normal check's
-        job.set("threads", threads(scene))
-        for name, value in node_parameters(node).items():
-            job.set(name, value)
-        for name, image in images.items():
-            job.set_image(name, image)
-        if overscan:
-            job.set_output_window(overscan, overscan)
-        for name, image in outputs.items():
-            job.set_image(name, image)
-        job.run()
+    height, width = outputs["ao"].shape[:2]
+    layers = range(2, 2 + sum(name.startswith("depth") for name in images) - 1)
+    # A frame without geometry (only sky) is AO 1, not an error: an animation goes on.
+    ao, composite = ssao.ambient_occlusion(
+        images["depth"], normals=images.get("normal"), camera=None,
+        depth_layers=[images[f"depth{k}"] for k in layers],
+        facing_layers=[images[f"facing{k}"] for k in layers], beauty=outputs["beauty"],
+        output_window=(overscan, overscan, width, height) if overscan else None,
+        require_geometry=False, run_stats=run_stats,
+        **camera, background_depth=background,  # the same as the Normal check's
+        threads=threads(scene), **node_parameters(node))
+    outputs["ao"][:, :, :3] = ao[:, :, np.newaxis]  # the library's "ao" image: AO, alpha 1
+    outputs["ao"][:, :, 3] = 1.0
+    outputs["composite"] = composite
     inner_tree.store_outputs(node, rgba, outputs)
     return np.ascontiguousarray(rgba[::-1, :, 0])
 
@@ -443,12 +444,15 @@ def compute_frame(scene, frame, since=0.0, outcome="written", wait=True):
                                    f"no exported passes for frame {frame} (is the node's output "
                                    "connected to the compositor's output?)")
             start = time.perf_counter()
-            ao = compute_node(node, scene, read_export(path), wait)
+            stats = {}
+            ao = compute_node(node, scene, read_export(path), wait, run_stats=stats)
             seconds = time.perf_counter() - start
             node.status = waiting_status(node, scene, frame) or \
                 f"Frame {frame}: {ao.shape[1]}x{ao.shape[0]} in {seconds * 1e3:.0f} ms"
+            # The library's figure: the mean over the geometry pixels (1 without any).
             report(f"{scene.name} frame {frame} node '{node.name}': {node.status}, "
-                   f"mean AO {float(ao.mean()):.4f}")
+                   f"mean AO {stats['mean_ao']:.4f} over {stats['geometry_pixels']} geometry "
+                   "pixels")
             done[node.name] = ao
         except Exception as error:
             done[node.name] = None

@@ -261,6 +261,30 @@ class OtherInputs(unittest.TestCase):
         self.assertTrue(np.all(ao[:20] == 1.0))
         self.assertTrue(np.all(np.isfinite(ao)))
 
+    def test_run_stats_and_a_frame_without_geometry(self):
+        depth = np.array(self.depth)
+        depth[:10] = np.inf
+        stats = {}
+        ao = ssao.ambient_occlusion(depth, camera=self.camera, radius=0.8, run_stats=stats)
+        # The library's count and mean, checked against the background rule's own statement:
+        # finite, positive and below background_depth (the camera has clip_end 100).
+        geometry = np.isfinite(depth) & (depth > 0) & (depth < 100.0)
+        self.assertEqual(stats["geometry_pixels"], int(geometry.sum()))
+        self.assertAlmostEqual(stats["mean_ao"], float(ao[geometry].mean()), places=5)
+        self.assertLess(stats["mean_ao"], float(ao.mean()))  # the sky's AO 1 is not counted
+        sky = np.full_like(depth, np.inf)
+        beauty = np.full(depth.shape + (3,), 0.5, np.float32)
+        with self.assertRaisesRegex(ssao.SSAOError, "no geometry pixel"):
+            ssao.ambient_occlusion(sky, camera=self.camera, radius=0.8)
+        for radius in ({"radius": 0.8}, {}):  # without a radius: no automatic one either
+            stats = {}
+            ao, composite = ssao.ambient_occlusion(sky, camera=self.camera, beauty=beauty,
+                                                   require_geometry=False, run_stats=stats,
+                                                   **radius)
+            self.assertTrue(np.all(ao == 1.0))
+            np.testing.assert_array_equal(composite, beauty)
+            self.assertEqual(stats, {"geometry_pixels": 0, "mean_ao": 1.0})
+
     def test_camera_file_path(self):
         with_dict = ssao.ambient_occlusion(self.depth, camera=self.camera, radius=0.8)
         for path in (SAMPLE + ".camera.json", pathlib.Path(SAMPLE + ".camera.json")):

@@ -136,7 +136,7 @@ def _check_image(name, array, shape, channels=None):
 
 def ambient_occlusion(depth, *, normals=None, camera, depth_layers=(), facing_layers=(),
                       beauty=None, ambient=None, output_window=None, progress=None,
-                      **parameters):
+                      require_geometry=True, run_stats=None, **parameters):
     """The AO of a depth pass: float32 (height, width), 1 = unoccluded, row 0 on top.
 
     depth          float32 (H, W): planar depth (Blender's Depth pass) or radial
@@ -156,6 +156,10 @@ def ambient_occlusion(depth, *, normals=None, camera, depth_layers=(), facing_la
                    frame, which is this window of them; the outputs have the window's size and
                    the camera describes the frame.
     progress       callable(fraction), optional; returning False cancels (SSAOError).
+    require_geometry  False: a depth without any geometry pixel gives AO 1 (and the composite
+                   its beauty) instead of SSAOError: a sky-only frame of an animation.
+    run_stats      a dict, optional: filled with what the run saw over the frame
+                   (ssao_job_last_run): "geometry_pixels" and "mean_ao", their mean final AO.
     parameters     the library's parameters by name (ssao.parameters()), e.g. radius=0.8,
                    variant="horizon", threads=4. Without radius: the camera's "ao_distance",
                    else the library's automatic radius (as the CLI chooses).
@@ -212,9 +216,14 @@ def ambient_occlusion(depth, *, normals=None, camera, depth_layers=(), facing_la
         try:  # without radius: the camera's "ao_distance", else the automatic radius
             job.choose_radius()
         except SSAOError:
-            raise SSAOError(_NO_GEOMETRY) from None
+            if require_geometry:
+                raise SSAOError(_NO_GEOMETRY) from None
+            # No geometry: AO 1 whatever the radius; the run still writes the outputs.
         job.run(progress)
-        if job.last_run()[0] == 0:
+        geometry_pixels, mean_ao = job.last_run()
+        if run_stats is not None:
+            run_stats.update(geometry_pixels=geometry_pixels, mean_ao=mean_ao)
+        if geometry_pixels == 0 and require_geometry:
             raise SSAOError(_NO_GEOMETRY)
     return (ao, composite) if beauty is not None else ao
 
