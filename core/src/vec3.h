@@ -1,24 +1,64 @@
 // SPDX-License-Identifier: MIT
-// Minimal 3-vector for view-space geometry.
+// The project's one 3-vector: the library's view-space geometry in floats (Vec3), and, header
+// only and depending on nothing, the doubles of the tests' analytic scenes and of POV-Ray's
+// scene reader (povray_bridge/scene), which include it too.
 #pragma once
 
 #include <cmath>
 
 namespace ssao {
 
-struct Vec3 {
-  float x = 0.0f, y = 0.0f, z = 0.0f;
+template <typename T>
+struct Vector3 {
+  T x = T(0), y = T(0), z = T(0);
+};
+using Vec3 = Vector3<float>;
+
+// The scalar of a product takes the vector's type (a double constant times a Vec3 stays float),
+// so it is not deduced from the argument.
+template <typename T>
+struct ScalarOf {
+  using type = T;
 };
 
-inline Vec3 operator+(Vec3 a, Vec3 b) { return {a.x + b.x, a.y + b.y, a.z + b.z}; }
-inline Vec3 operator-(Vec3 a, Vec3 b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
-inline Vec3 operator*(Vec3 a, float s) { return {a.x * s, a.y * s, a.z * s}; }
-inline Vec3 operator-(Vec3 a) { return {-a.x, -a.y, -a.z}; }
-inline float dot(Vec3 a, Vec3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
-inline Vec3 cross(Vec3 a, Vec3 b) {
+template <typename T>
+inline Vector3<T> operator+(Vector3<T> a, Vector3<T> b) {
+  return {a.x + b.x, a.y + b.y, a.z + b.z};
+}
+template <typename T>
+inline Vector3<T> operator-(Vector3<T> a, Vector3<T> b) {
+  return {a.x - b.x, a.y - b.y, a.z - b.z};
+}
+template <typename T>
+inline Vector3<T> operator-(Vector3<T> a) {
+  return {-a.x, -a.y, -a.z};
+}
+template <typename T>
+inline Vector3<T> operator*(Vector3<T> a, typename ScalarOf<T>::type s) {
+  return {a.x * s, a.y * s, a.z * s};
+}
+template <typename T>
+inline Vector3<T> operator*(typename ScalarOf<T>::type s, Vector3<T> a) {
+  return a * s;
+}
+template <typename T>
+inline T dot(Vector3<T> a, Vector3<T> b) {
+  return a.x * b.x + a.y * b.y + a.z * b.z;
+}
+template <typename T>
+inline Vector3<T> cross(Vector3<T> a, Vector3<T> b) {
   return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
 }
-inline float length(Vec3 a) { return std::sqrt(dot(a, a)); }
+template <typename T>
+inline T length(Vector3<T> a) {
+  return std::sqrt(dot(a, a));
+}
+// a / |a|, or a itself when |a| = 0.
+template <typename T>
+inline Vector3<T> normalized(Vector3<T> a) {
+  const T len = length(a);
+  return len > T(0) ? a * (T(1) / len) : a;
+}
 
 // Returns a / |a|, or `fallback` when a is zero, tiny or not finite.
 inline Vec3 normalize_or(Vec3 a, Vec3 fallback) {

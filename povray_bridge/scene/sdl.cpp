@@ -16,16 +16,6 @@ namespace povray_ssao {
 
 namespace fs = std::filesystem;
 
-double dot(V3 a, V3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
-V3 cross(V3 a, V3 b) {
-  return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
-}
-double length(V3 a) { return std::sqrt(dot(a, a)); }
-V3 normalized(V3 a) {
-  const double len = length(a);
-  return len > 0.0 ? a * (1.0 / len) : a;
-}
-
 std::string format_vector(V3 v) {
   char buffer[128];
   std::snprintf(buffer, sizeof buffer, "<%.6g, %.6g, %.6g>", v.x, v.y, v.z);

@@ -12,23 +12,14 @@
 #include <string>
 #include <vector>
 
+#include "src/vec3.h"  // core/ is on the include path (ssao_tools)
 #include "tools/error.h"
 
 namespace povray_ssao {
 
-// A 3-vector in doubles (POV-Ray's coordinates: left-handed, +y up).
-struct V3 {
-  double x = 0.0, y = 0.0, z = 0.0;
-};
-inline V3 operator+(V3 a, V3 b) { return {a.x + b.x, a.y + b.y, a.z + b.z}; }
-inline V3 operator-(V3 a, V3 b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
-inline V3 operator-(V3 a) { return {-a.x, -a.y, -a.z}; }
-inline V3 operator*(V3 a, double s) { return {a.x * s, a.y * s, a.z * s}; }
-inline V3 operator*(double s, V3 a) { return a * s; }
-double dot(V3 a, V3 b);
-V3 cross(V3 a, V3 b);
-double length(V3 a);
-V3 normalized(V3 a);              // a itself when |a| = 0
+// A 3-vector in doubles (POV-Ray's coordinates: left-handed, +y up): the project's one vector
+// type (core/src/vec3.h, header only), with dot, cross, length and normalized.
+using V3 = ssao::Vector3<double>;
 std::string format_vector(V3 v);  // "<1, 2.5, -3>"
 
 // POV-Ray's "rotate <a, b, c>": about x by a degrees, then y by b, then z by c, each as POV-Ray's

@@ -15,18 +15,14 @@
 #include <utility>
 #include <vector>
 
+#include "../../core/src/vec3.h"  // the project's 3-vector, header only
 #include "ssao/ssao.h"
 
 namespace test {
 
-struct V3 {
-  double x, y, z;
-};
-inline V3 operator+(V3 a, V3 b) { return {a.x + b.x, a.y + b.y, a.z + b.z}; }
-inline V3 operator-(V3 a, V3 b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
-inline V3 operator*(V3 a, double s) { return {a.x * s, a.y * s, a.z * s}; }
-inline double dot(V3 a, V3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
-inline V3 normalized(V3 a) { return a * (1.0 / std::sqrt(dot(a, a))); }
+using V3 = ssao::Vector3<double>;
+// Not a template: takes a braced {x, y, z}.
+inline V3 normalized(V3 a) { return ssao::normalized(a); }
 
 // A plane bounding a solid: points p with dot(normal, p - point) < 0 are inside.
 struct Plane {
