@@ -758,6 +758,11 @@ CameraReading read_camera(const SceneScan& scan, const CameraOverrides& override
     const CameraSource& source = scan.cameras.back();
     try {
       Spec spec;
+      if (source.kind == CameraSource::kMacroCall) {
+        throw EvalError(source.location + ": the camera is made by the macro '" + source.macro +
+                        "' (its camera { } block at " + source.macro_camera_at +
+                        "), which povray-ssao does not expand");
+      }
       if (source.kind == CameraSource::kSSAOCameraMacro) {
         spec = parse_macro_camera(source, width, height, scan.clock);
       } else {

@@ -866,6 +866,7 @@ class Scanner {
 
  private:
   void scan_tokens(const std::vector<Token>& tokens, int depth) {
+    find_camera_macros(tokens);
     size_t i = 0;
     while (tokens[i].kind != Token::kEnd) {
       const Token& token = tokens[i];
@@ -911,7 +912,71 @@ class Scanner {
         i = end;
         continue;
       }
+      const auto made_by = token.kind == Token::kIdent && is_punct(tokens[i + 1], "(")
+                               ? camera_macros_.find(token.text)
+                               : camera_macros_.end();
+      if (made_by != camera_macros_.end()) {
+        // A call of a macro that makes a camera: not expanded, but never passed over (the
+        // camera POV-Ray uses would silently be another).
+        CameraSource camera;
+        camera.kind = CameraSource::kMacroCall;
+        camera.macro = made_by->first;
+        camera.macro_camera_at = made_by->second;
+        camera.location = where(token);
+        camera.conditional = conditionals_.unknown_depth() > 0;
+        result.cameras.push_back(std::move(camera));
+        i = skip_group(tokens, i + 1);
+        continue;
+      }
       ++i;
+    }
+  }
+
+  // The macros of `tokens` that make a camera: a camera { } block in their body, or a call of
+  // such a macro (screen.inc's Set_Camera calls Update_Camera), with where that block is.
+  // (SSAOCamera, ssao_passes.inc's, is read from its arguments instead.)
+  void find_camera_macros(const std::vector<Token>& tokens) {
+    struct Body {
+      std::string name;
+      size_t begin, end;
+    };
+    std::vector<Body> bodies;
+    for (size_t i = 0; tokens[i].kind != Token::kEnd; ++i) {
+      if (tokens[i].kind != Token::kDirective || tokens[i].text != "macro" ||
+          tokens[i + 1].kind != Token::kIdent || !is_punct(tokens[i + 2], "(")) {
+        continue;
+      }
+      const size_t begin = skip_group(tokens, i + 2);
+      size_t end = begin;
+      for (int open = 1; tokens[end].kind != Token::kEnd; ++end) {
+        const Token& t = tokens[end];
+        if (t.kind != Token::kDirective) continue;
+        if (t.text == "if" || t.text == "ifdef" || t.text == "ifndef" || t.text == "switch" ||
+            t.text == "while" || t.text == "for" || t.text == "macro") {
+          ++open;
+        } else if (t.text == "end" && --open == 0) {
+          break;
+        }
+      }
+      if (tokens[i + 1].text != "SSAOCamera") bodies.push_back({tokens[i + 1].text, begin, end});
+    }
+    for (bool changed = true; changed;) {
+      changed = false;
+      for (const Body& body : bodies) {
+        if (camera_macros_.count(body.name)) continue;
+        for (size_t k = body.begin; k < body.end; ++k) {
+          const Token& t = tokens[k];
+          if (t.kind != Token::kIdent || !is_punct(tokens[k + 1], t.text == "camera" ? "{" : "(")) {
+            continue;
+          }
+          const auto called = camera_macros_.find(t.text);
+          if (t.text == "camera" || called != camera_macros_.end()) {
+            camera_macros_[body.name] = t.text == "camera" ? where(t) : called->second;
+            changed = true;
+            break;
+          }
+        }
+      }
     }
   }
 
@@ -1066,8 +1131,10 @@ class Scanner {
           (is_punct(tokens[i + 1], "[") || is_punct(tokens[i + 1], "{"))) ||
          (first.text == "function" && is_punct(tokens[i + 1], "(")))) {
       size_t j = i + 1;
+      // "#declare A = array[3]" may end without ';': a directive ends it too (found on
+      // povray-examples' incdemo/glasses/glass.pov, whose next #declare was swallowed).
       while (!is_punct(tokens[j], "{") && !is_punct(tokens[j], ";") &&
-             tokens[j].kind != Token::kEnd) {
+             tokens[j].kind != Token::kEnd && tokens[j].kind != Token::kDirective) {
         j = is_punct(tokens[j], "[") || is_punct(tokens[j], "(") ? skip_group(tokens, j) : j + 1;
       }
       size_t end = is_punct(tokens[j], "{") ? skip_group(tokens, j) : j;
@@ -1133,6 +1200,7 @@ class Scanner {
   int includes_read_ = 0;
   size_t settings_end_ = 0;  // index after the global_settings block being read (this file)
   Symbols symbols_;
+  std::map<std::string, std::string> camera_macros_;  // macro -> where its camera block is
   EvalContext context_;
   Conditionals conditionals_;
 };

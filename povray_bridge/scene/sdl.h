@@ -138,8 +138,10 @@ class Conditionals {
 
 // A camera found in the scene text.
 struct CameraSource {
-  enum Kind { kBlock, kSSAOCameraMacro };
+  // kMacroCall: a call of a macro of the scene whose body makes a camera (not expanded).
+  enum Kind { kBlock, kSSAOCameraMacro, kMacroCall };
   Kind kind = kBlock;
+  std::string macro, macro_camera_at;  // kMacroCall: the macro, where its camera block is
   std::vector<Token> tokens;  // block contents without the braces, or the macro's arguments
   std::string location;       // "scene.pov:25"
   bool conditional = false;   // inside a conditional that could not be evaluated, or a loop

@@ -294,6 +294,13 @@ TEST_F(SceneFile, CameraFormsTable) {
        40,
        1.33},
       {"camera { sky z location <0, -5, 0> look_at 0 angle 60 }", {0, -5, 0}, {0, 1, 0}, 60, 1.33},
+      // An array declared without ';' ends at the next directive (incdemo/glasses/glass.pov).
+      {"#declare T = 5; #declare A = array[3] #if (0) #declare T = 1; #end "
+       "camera { location -T * z look_at 0 angle 60 }",
+       {0, 0, -5},
+       {0, 0, 1},
+       60,
+       1.33},
       {"camera { orthographic location <0, 0, -5> look_at 0 right 8 * x up 6 * y }",
        {0, 0, -5},
        {0, 0, 1},
@@ -331,6 +338,11 @@ TEST_F(SceneFile, RefusalsNameTheConstruct) {
       {"camera { location 0 look_at z angle 180 }", "angle"},
       {"camera { location <0, 0, -5> look_at Target }", "Target"},
       {"camera { location 0 look_at z angle Fov(3) }", "Fov"},
+      // A macro that makes the camera is not expanded, but never passed over (povray-examples'
+      // incdemo/math.pov; screen.inc's Set_Camera calls Update_Camera).
+      {"#macro Cam(D) camera { location <0, 2, -D> look_at 0 } #end Cam(5)", "macro 'Cam'"},
+      {"#macro In() camera { location -z look_at 0 } #end #macro Out() In() #end Out()",
+       "macro 'Out' (its camera { } block at scene.pov:1)"},
   };
   for (const Case& c : cases) {
     try {
