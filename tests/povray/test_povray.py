@@ -1388,9 +1388,8 @@ class DefaultCameraTest(PovTestCase):
                                delta=0.02)
 
     def test_a_camera_the_scan_cannot_see_is_refused(self):
-        # A camera made by a macro: the text has no camera { } block the scan reads, yet POV-Ray
-        # renders another view than the default one. Declaring the default camera after the
-        # scene would silently replace it.
+        # A camera made by a macro: the reader does not expand macros, but sees that this one
+        # makes the camera, and names it.
         scene = self.copy_scene("macro.pov", NO_CAMERA_SCENE + """#macro MyCamera(L)
   camera { location L look_at <0, 0, 5> angle 50 }
 #end
@@ -1398,6 +1397,15 @@ MyCamera(<2, 3, -3>)
 """)
         out, exr = self.path("out.png"), self.path("out.exr")
         proc = self.run_bridge(scene, "-o", out, "--exr", exr, "+W32", "+H24")
+        self.assert_fails(proc, "the camera is made by the macro 'MyCamera'", "--camera-location",
+                          outputs=[out, exr])
+        # A camera the text does not show at all (parsed from a string): POV-Ray itself renders
+        # another view than the default one. Declaring the default camera after the scene
+        # would silently replace it.
+        hidden = self.copy_scene("hidden.pov", NO_CAMERA_SCENE + """#include "strings.inc"
+Parse_String("camera { location <2, 3, -3> look_at <0, 0, 5> angle 50 }")
+""")
+        proc = self.run_bridge(hidden, "-o", out, "--exr", exr, "+W32", "+H24")
         self.assert_fails(proc, "another camera than its default one", "--camera-location",
                           outputs=[out, exr])
         # The flags give the camera: then the scene's own does not matter.
