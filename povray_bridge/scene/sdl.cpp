@@ -695,6 +695,13 @@ size_t after_argument(const std::vector<Token>& tokens, size_t i) {
   return is_punct(tokens[i + 1], "(") ? skip_group(tokens, i + 1) : i + 1;
 }
 
+// A directive whose block an #end closes.
+bool opens_block(const std::string& directive) {
+  return directive == "if" || directive == "ifdef" || directive == "ifndef" ||
+         directive == "switch" || directive == "while" || directive == "for" ||
+         directive == "macro";
+}
+
 }  // namespace
 
 bool Conditionals::active() const {
@@ -747,8 +754,7 @@ size_t Conditionals::handle(const std::vector<Token>& tokens, size_t i,
   if (token.kind != Token::kDirective) return i;
   const std::string& name = token.text;
   const bool was_active = active();
-  if (name == "if" || name == "ifdef" || name == "ifndef" || name == "switch" || name == "while" ||
-      name == "for" || name == "macro") {
+  if (opens_block(name)) {
     Frame frame;
     if (!was_active || name == "macro") {
       // Nothing in here runs: a skipped branch, or a macro's body (run only when called).
@@ -951,8 +957,7 @@ class Scanner {
       for (int open = 1; tokens[end].kind != Token::kEnd; ++end) {
         const Token& t = tokens[end];
         if (t.kind != Token::kDirective) continue;
-        if (t.text == "if" || t.text == "ifdef" || t.text == "ifndef" || t.text == "switch" ||
-            t.text == "while" || t.text == "for" || t.text == "macro") {
+        if (opens_block(t.text)) {
           ++open;
         } else if (t.text == "end" && --open == 0) {
           break;
