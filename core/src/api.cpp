@@ -205,11 +205,12 @@ SSAO_API ssao_status ssao_job_last_run(ssao_job job, size_t* geometry_pixels, do
   });
 }
 
-SSAO_API ssao_status ssao_job_set_camera_json(ssao_job job, const char* json_text,
+SSAO_API ssao_status ssao_job_set_camera_json(ssao_job job, const char* json_text, size_t length,
                                               const char* source) {
   return guarded([&] {
     if (json_text == nullptr) ssao::throw_invalid_argument("camera file text is NULL");
-    checked(job).set_camera_json(json_text, source != nullptr ? source : "camera");
+    checked(job).set_camera_json(std::string(json_text, length),
+                                 source != nullptr ? source : "camera");
   });
 }
 

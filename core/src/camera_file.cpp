@@ -234,6 +234,9 @@ void set_param(const std::string& source, const char* key, Set&& set) {
 
 CameraFile apply_camera_json(const std::string& text, const std::string& source,
                              ParamValues& params) {
+  if (text.find('\0') != std::string::npos) {  // JSON text has none; the parser would stop there
+    throw_invalid_argument("camera file '" + source + "': malformed JSON: it holds a NUL byte");
+  }
   Json root;
   try {
     root = Json::parse(text);

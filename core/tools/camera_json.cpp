@@ -24,10 +24,6 @@ std::string read_camera_text(const std::string& path) {
 
 std::vector<std::string> apply_camera_text(ssao::api::Job& job, const std::string& text,
                                            const std::string& path) {
-  // The C API takes a C string: a NUL would end the text early and hide what follows.
-  if (text.find('\0') != std::string::npos) {
-    throw Error("camera file '" + path + "': malformed JSON: it holds a NUL byte");
-  }
   try {
     job.set_camera_json(text, path);
     return job.camera_unknown_keys();

@@ -46,7 +46,7 @@ std::string camera_with(const std::string& key, const char* value) {
 }
 
 ssao_status set_camera(Job& job, const std::string& text) {
-  return ssao_job_set_camera_json(job.get(), text.c_str(), "shot.camera.json");
+  return ssao_job_set_camera_json(job.get(), text.data(), text.size(), "shot.camera.json");
 }
 
 }  // namespace
@@ -79,6 +79,7 @@ TEST(CameraFile, RefusesWhatTheFormatForbidsAndLeavesTheJobAsItWas) {
   };
   const std::vector<Case> cases = {
       {"", "malformed JSON"},
+      {std::string(kBlenderCamera) + '\0' + "}", "it holds a NUL byte"},
       {"[1, 2]", "expected a JSON object, got an array"},
       {"{\"type\": \"PERSP\",", "malformed JSON"},
       {camera_with("type", nullptr), "missing key 'type'"},
@@ -158,10 +159,11 @@ TEST(CameraFile, ListsTheKeysItDoesNotKnow) {
   ASSERT_EQ(ssao_job_camera_unknown_keys(job.get(), small, sizeof small), SSAO_OK);
   EXPECT_STREQ(small, "dof,");
   EXPECT_EQ(ssao_job_camera_unknown_keys(job.get(), nullptr, 4), SSAO_ERROR_INVALID_ARGUMENT);
-  EXPECT_EQ(ssao_job_set_camera_json(job.get(), nullptr, "x"), SSAO_ERROR_INVALID_ARGUMENT);
-  EXPECT_EQ(ssao_job_set_camera_json(nullptr, kBlenderCamera, "x"), SSAO_ERROR_INVALID_ARGUMENT);
+  EXPECT_EQ(ssao_job_set_camera_json(job.get(), nullptr, 0, "x"), SSAO_ERROR_INVALID_ARGUMENT);
+  EXPECT_EQ(ssao_job_set_camera_json(nullptr, kBlenderCamera, 10, "x"),
+            SSAO_ERROR_INVALID_ARGUMENT);
   // Without a source the messages say "camera".
-  EXPECT_EQ(ssao_job_set_camera_json(job.get(), "{", nullptr), SSAO_ERROR_INVALID_ARGUMENT);
+  EXPECT_EQ(ssao_job_set_camera_json(job.get(), "{", 1, nullptr), SSAO_ERROR_INVALID_ARGUMENT);
   EXPECT_NE(std::strstr(ssao_last_error(), "camera file 'camera'"), nullptr);
 }
 

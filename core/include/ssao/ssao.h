@@ -220,7 +220,8 @@ SSAO_API ssao_status ssao_job_last_run(ssao_job job, size_t* geometry_pixels, do
 /* The front ends' rules, in one place: the CLI, the POV-Ray bridge, the Python module and the
  * Blender add-on call these rather than writing them again. */
 
-/* Sets the camera from the text of a camera file (JSON; docs/conventions.md, "Camera file":
+/* Sets the camera from the text of a camera file, `length` bytes of JSON (docs/conventions.md,
+ * "Camera file":
  * Blender's camera property names, or another renderer's intrinsics or projection matrix). The
  * one reader of the format: it checks every rule (the keys the projection needs, the types of
  * the values, finite numbers, positive sizes, matrix shapes, the library's ranges) and sets the
@@ -229,7 +230,7 @@ SSAO_API ssao_status ssao_job_last_run(ssao_job job, size_t* geometry_pixels, do
  * and ssao_last_error() names `source` (NULL: "camera") and the key. The file's "ao_distance"
  * is remembered for ssao_job_choose_radius(); keys the format does not know are ignored and
  * listed by ssao_job_camera_unknown_keys(). */
-SSAO_API ssao_status ssao_job_set_camera_json(ssao_job job, const char* json_text,
+SSAO_API ssao_status ssao_job_set_camera_json(ssao_job job, const char* json_text, size_t length,
                                               const char* source);
 /* The keys of the last camera file that the format does not know, comma-separated ("" for none),
  * truncated to size - 1 characters as ssao_job_get_string truncates. */

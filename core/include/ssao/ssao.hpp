@@ -117,7 +117,7 @@ class Job {
   // The camera of a camera file's text (ssao_job_set_camera_json); `source` names it in messages,
   // which carry their own context.
   void set_camera_json(const std::string& text, const std::string& source) {
-    check_status(ssao_job_set_camera_json(job_, text.c_str(), source.c_str()), "");
+    check_status(ssao_job_set_camera_json(job_, text.data(), text.size(), source.c_str()), "");
   }
   // The keys of the last camera file that the format does not know.
   std::vector<std::string> camera_unknown_keys() const {

@@ -163,7 +163,7 @@ def _declare(lib):
             ctypes.POINTER(c_double))
     if hasattr(lib, "ssao_job_set_camera_json"):  # since 0.1 after issue 35
         # Their messages carry their own context (the camera file, the key): raised as they are.
-        sig("ssao_job_set_camera_json", c_int, job, cstr, cstr, checked=False)
+        sig("ssao_job_set_camera_json", c_int, job, cstr, ctypes.c_size_t, cstr, checked=False)
         sig("ssao_job_camera_unknown_keys", c_int, job, ctypes.c_char_p, ctypes.c_size_t)
         sig("ssao_job_is_set", c_int, job, cstr, ctypes.POINTER(c_int))
         sig("ssao_job_choose_radius", c_int, job, c_int, ctypes.POINTER(c_double),
@@ -376,9 +376,8 @@ class Job:
         unchanged. Returns the keys the format does not know (ignored)."""
         if not isinstance(text, str):
             raise SSAOError(f"camera file text must be a str, got {type(text).__name__}")
-        if "\0" in text:
-            raise SSAOError(f"camera file '{source}': malformed JSON: it holds a NUL character")
-        self._raise_unless_ok(self._lib.ssao_job_set_camera_json(self._job, text.encode(),
+        data = text.encode()
+        self._raise_unless_ok(self._lib.ssao_job_set_camera_json(self._job, data, len(data),
                                                                  str(source).encode()))
         keys = ctypes.create_string_buffer(4096)
         self._lib.ssao_job_camera_unknown_keys(self._job, keys, len(keys))
