@@ -313,25 +313,22 @@ def compute_node(node, scene, passes, wait=True, run_stats=None):
     check_depth(passes[:, :, 3])
     if use_normals:
         check_normals(scene, passes, min(background, camera["clip_end"] or math.inf))
-    rgba, outputs = inner_tree.library_outputs(passes)
+    beauty = inner_tree.white_beauty(passes)
     # Blender's rows run bottom-up, the library's top-down: flipped views read in place.
     images, overscan = library_inputs(node, scene, passes, use_normals, wait)
-    height, width = outputs["ao"].shape[:2]
-    layers = range(2, 2 + sum(name.startswith("depth") for name in images) - 1)
+    height, width = beauty.shape[:2]
+    layers = range(2, 2 + sum(name.startswith("facing") for name in images))  # depth2, ...
     # A frame without geometry (only sky) is AO 1, not an error: an animation goes on.
     ao, composite = ssao.ambient_occlusion(
         images["depth"], normals=images.get("normal"), camera=None,
         depth_layers=[images[f"depth{k}"] for k in layers],
-        facing_layers=[images[f"facing{k}"] for k in layers], beauty=outputs["beauty"],
+        facing_layers=[images[f"facing{k}"] for k in layers], beauty=beauty,
         output_window=(overscan, overscan, width, height) if overscan else None,
         require_geometry=False, run_stats=run_stats,
         **camera, background_depth=background,  # the same as the Normal check's
         threads=threads(scene), **node_parameters(node))
-    outputs["ao"][:, :, :3] = ao[:, :, np.newaxis]  # the library's "ao" image: AO, alpha 1
-    outputs["ao"][:, :, 3] = 1.0
-    outputs["composite"] = composite
-    inner_tree.store_outputs(node, rgba, outputs)
-    return np.ascontiguousarray(rgba[::-1, :, 0])
+    inner_tree.store_outputs(node, ao, composite)
+    return ao
 
 
 def library_inputs(node, scene, passes, use_normals, wait=True):

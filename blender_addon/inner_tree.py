@@ -238,26 +238,26 @@ def ao_image(node, width, height):
     return image
 
 
-def library_outputs(passes):
-    """(pixels, {library image name: array, row 0 on top}) for a run on `passes` (compute.py's
-    bottom-up export: normal xyz, depth and, when it was exported, the Image's alpha): pixels
-    are the AO image's, bottom-up (height, width, 4); the run writes the AO into them ("ao")
-    and the composite of a white image with the Image's alpha into a buffer of its own
-    ("beauty", which is also the "composite"); store_outputs() then puts that factor into
-    Green."""
+def white_beauty(passes):
+    """The beauty of a run on `passes` (compute.py's bottom-up export: normal xyz, depth and,
+    when it was exported, the Image's alpha): white with the Image's alpha, row 0 on top. Its
+    composite is the factor the composite applies to the Image (store_outputs)."""
     height, width = passes.shape[:2]
-    pixels = np.empty((height, width, 4), np.float32)
-    white = np.ones((height, width, 4), np.float32)  # row 0 on top
+    white = np.ones((height, width, 4), np.float32)
     if passes.shape[2] > 4:
         white[:, :, 3] = passes[::-1, :, 4]
-    return pixels, {"ao": pixels[::-1], "beauty": white, "composite": white}
+    return white
 
 
-def store_outputs(node, pixels, outputs):
-    """The AO image's pixels after a run of library_outputs(): Red (and Blue) the AO, Green the
-    composite's factor, alpha 1; the image is filled and tagged. Returns it."""
-    pixels[:, :, 1] = outputs["composite"][::-1, :, 0]
-    height, width = pixels.shape[:2]
+def store_outputs(node, ao, composite):
+    """Fills and tags the AO image from a run's `ao` (height, width) and the `composite` of
+    white_beauty(), both row 0 on top: Red (and Blue) the AO, Green the composite's factor,
+    alpha 1, rows bottom-up as Blender's. Returns the image."""
+    height, width = ao.shape
+    pixels = np.empty((height, width, 4), np.float32)
+    pixels[:, :, 0] = pixels[:, :, 2] = ao[::-1]
+    pixels[:, :, 1] = composite[::-1, :, 0]
+    pixels[:, :, 3] = 1.0
     image = ao_image(node, width, height)
     image.pixels.foreach_set(pixels.ravel())
     image.update()
