@@ -9,8 +9,9 @@ Modules: node (the node type), inner_tree (its built-in inner nodes), compute (l
 ssao (the Python module core/python/ssao, the one ctypes binding; a link in the source tree, a
 copy in the zip), recomposite (running the compositor again), multilayer (EXR layers),
 saved_form (how a .blend carries the node), handlers (render and file events), main_thread
-(render-thread handlers' work done on the main thread), operators, preferences, camera, compat
-(every Blender-version difference)."""
+(render-thread handlers' work done on the main thread), session (everything the add-on
+remembers between events: one object, begun by register()), operators, preferences, camera,
+compat (every Blender-version difference)."""
 
 bl_info = {
     "name": "Ambient Occlusion (SSAO) compositor node",
@@ -22,7 +23,7 @@ bl_info = {
     "category": "Compositing",
 }
 
-from . import compute, handlers, node, operators, preferences  # noqa: E402
+from . import compute, handlers, node, operators, preferences, session  # noqa: E402
 
 # Scripting entry point: ssao_compositor.compute_ao(scene) -> numpy array (height, width).
 compute_ao = compute.compute_ao
@@ -31,6 +32,7 @@ _modules = (preferences, node, handlers, operators)
 
 
 def register():
+    session.begin()
     for module in _modules:
         module.register()
 
@@ -38,3 +40,4 @@ def register():
 def unregister():
     for module in reversed(_modules):
         module.unregister()
+    session.end()

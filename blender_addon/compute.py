@@ -1,15 +1,17 @@
 # SPDX-License-Identifier: MIT
 """Computing the AO: the node's exported passes in, libssao, the node's AO image out."""
+import functools
 import math
 import os
 import tempfile
 import time
+import types
 
 import bpy
 import numpy as np
 
 from . import camera as camera_module
-from . import compat, helper_process, hidden_surfaces, inner_tree, ssao
+from . import compat, helper_process, hidden_surfaces, inner_tree, session, ssao
 
 # Where exporters write (per process; $SSAO_COMPOSITOR_EXPORT_DIR or the add-on's preference
 # override it, e.g. to keep the passes for the command-line tool). Saved files carry
@@ -27,19 +29,31 @@ EEVEE_BACKGROUND_DEPTH = 65504.0
 # The library's parameter groups (ssao_param_group) the node shows: every parameter that
 # changes the look. The input, camera and execution groups the add-on sets itself.
 NODE_GROUPS = ("ao", "quality", "shaping")
-_node_parameter_names = None
+
+
+@functools.lru_cache(maxsize=1)
+def library_table():
+    """libssao's parameter and variant tables as the add-on uses them, read once (raises when
+    the library cannot be loaded; a later call tries again):
+      parameters: {name: description (ssao.parameters)}, in the library's order;
+      node_parameter_names: the names the node shows (NODE_GROUPS), in that order;
+      variant_parameters: {variant: the names only that variant reads}."""
+    lib = library()
+    parameters = {p["name"]: p for p in ssao.parameters(lib)}
+    return types.SimpleNamespace(
+        parameters=parameters,
+        node_parameter_names=tuple(name for name, p in parameters.items()
+                                   if p["group"] in NODE_GROUPS),
+        variant_parameters={v["name"]: set(v["parameters"]) for v in ssao.variants(lib)})
 
 
 def node_parameter_names():
-    """The names of the library's parameters the node shows, in the table's order."""
-    global _node_parameter_names
-    if _node_parameter_names is None:
-        try:
-            table = ssao.parameters(library())
-        except Exception:  # no library: the node shows its error, a .blend still saves
-            return ()
-        _node_parameter_names = tuple(p["name"] for p in table if p["group"] in NODE_GROUPS)
-    return _node_parameter_names
+    """The names of the library's parameters the node shows, in the table's order; none
+    without the library (the node shows its error, a .blend still saves)."""
+    try:
+        return library_table().node_parameter_names
+    except Exception:
+        return ()
 
 # The node's own settings (not library parameters): what the add-on renders for the library
 # beyond the user's passes (hidden_surfaces.py). Saved with the node's parameters.
@@ -69,9 +83,6 @@ NORMAL_PLAUSIBLE_MIN = 0.75
 NORMAL_CHECK_SAMPLES = 4096  # pixels on a grid: a few ms at any size
 NORMAL_CHECK_MIN_PIXELS = 64  # fewer smooth surface pixels than this: nothing to judge by
 
-preferred_export_dir = ""  # set by preferences.py
-
-
 def library():
     """The bundled libssao (the zip's lib/, beside the ssao module), loaded once."""
     return ssao.library()
@@ -82,7 +93,7 @@ def report(message, error=False):
 
 
 def export_dir():
-    return (os.environ.get("SSAO_COMPOSITOR_EXPORT_DIR") or preferred_export_dir
+    return (os.environ.get("SSAO_COMPOSITOR_EXPORT_DIR") or session.current.export_dir
             or PROCESS_EXPORT_DIR)
 
 
@@ -270,14 +281,9 @@ def check_normals(scene, passes, background):
             "to rebuild the normals from the depth")
 
 
-_defaults = {}
-
-
 def library_default(name):
     """A float parameter's default, from the library's table (never repeated here)."""
-    if name not in _defaults:
-        _defaults.update({p["name"]: p["default"] for p in ssao.parameters(library())})
-    return _defaults[name]
+    return library_table().parameters[name]["default"]
 
 
 def without_ao(node, scene):
@@ -344,7 +350,7 @@ def library_inputs(node, scene, passes, use_normals, wait=True):
     if hits == 1 and not overscan:
         helper_process.withdraw(scene.name, node.name)
         return user_passes, 0
-    if wait or not helper_process.enabled:
+    if wait or not session.current.use_helper_process:
         layers = hidden_surfaces.render_layers(scene, hits, overscan, folder=export_dir())
     else:
         layers = helper_process.layers_or_request(scene, hits, overscan, node.name)

@@ -23,14 +23,9 @@ import time
 
 import bpy
 
-from . import compat, compute, helper_process, hidden_surfaces, inner_tree, main_thread, \
-    recomposite, saved_form
+from . import compat, compute, helper_process, hidden_surfaces, inner_tree, recomposite, \
+    saved_form, session
 from .compute import report
-
-_pending_frames = []    # UI: (scene name, frame) rendered, waiting for the main-thread timer
-_written_frames = []    # UI: (scene name, frame, output file, passes file) of an animation
-_recomposited = {}      # headless: (scene name, frame) -> (passes file, AO layers)
-_render_started = 0.0   # time.time() of the last render's start: older exports are stale
 
 
 def ao_layers(aos):
@@ -58,12 +53,9 @@ def _written_output(scene, frame):
     return max(candidates, key=os.path.getmtime) if candidates else None
 
 
-_movie_warned = set()
-
-
 def _warn_movie_once(scene):
-    if scene.name not in _movie_warned:
-        _movie_warned.add(scene.name)
+    if scene.name not in session.current.movie_warned:
+        session.current.movie_warned.add(scene.name)
         report(f"scene '{scene.name}' renders to a movie, which cannot be written again: its "
                "frames get the AO of the frame before. Render to image files (PNG, EXR) and "
                "make the movie from them", error=True)
@@ -76,28 +68,23 @@ def _remove(path):
         pass
 
 
-def _helper_rendering():
-    """The add-on's own renders (re-composite, hidden surfaces) fire the handlers too."""
-    return recomposite.is_running() or hidden_surfaces.is_running()
-
-
 @bpy.app.handlers.persistent
 def _on_render_pre(scene, *_):
-    global _render_started
-    if _helper_rendering():
+    state = session.current
+    if state.helper_rendering():
         return
     # A new render: the layers kept, or being rendered, are of the last one.
     hidden_surfaces.forget(scene.name)
     helper_process.cancel(scene.name)
-    if bpy.app.background or not _written_frames:  # (the UI: the animation's first frame)
-        _render_started = time.time() - 1.0  # file times may be rounded to the second
+    if bpy.app.background or not state.written_frames:  # (the UI: the animation's 1st frame)
+        state.render_started = time.time() - 1.0  # file times may be rounded to the second
     if not bpy.app.background:
         return  # the render thread: nothing more here
     # A frame whose re-composite failed or was never written must not lend its result to this
     # one.
-    for passes, _ in _recomposited.values():
+    for passes, _ in state.recomposited.values():
         _remove(passes)
-    _recomposited.clear()
+    state.recomposited.clear()
     # A file loaded before the add-on registered (5.x: `blender -b file --addons ...` registers
     # with bpy.data out of reach) still carries its nodes as group nodes: turn them back now.
     set_up_nodes()
@@ -112,11 +99,12 @@ def _on_render_pre(scene, *_):
 
 @bpy.app.handlers.persistent
 def _on_render_post(scene, *_):
-    if _helper_rendering():
+    state = session.current
+    if state.helper_rendering():
         return
     if not bpy.app.background:
         # The render thread: only record (_finish_rendered_frames skips scenes without nodes).
-        _pending_frames.append((scene.name, scene.frame_current))
+        state.pending_frames.append((scene.name, scene.frame_current))
         return
     if not compute.ssao_nodes(scene):
         return
@@ -125,7 +113,7 @@ def _on_render_post(scene, *_):
         _warn_movie_once(scene)
     # Headless, the scene's objects (the camera) still hold the frame the file was saved at.
     scene.frame_set(frame)
-    aos = compute.compute_frame(scene, frame, _render_started)
+    aos = compute.compute_frame(scene, frame, state.render_started)
     # Nothing computed: the render's own composite is already the image without AO.
     if not _computed(aos) or compat.is_movie(scene.render.image_settings):
         return
@@ -133,7 +121,7 @@ def _on_render_post(scene, *_):
     try:
         recomposite.save_passes(scene, passes)
         recomposite.recomposite(scene, passes)
-        _recomposited[(scene.name, frame)] = (passes, ao_layers(aos))
+        state.recomposited[(scene.name, frame)] = (passes, ao_layers(aos))
     except Exception as error:
         report(f"{scene.name} frame {frame}: written WITHOUT AO: re-compositing it failed: "
                f"{error}", error=True)
@@ -143,7 +131,8 @@ def _on_render_post(scene, *_):
 @bpy.app.handlers.persistent
 def _on_render_write(scene, *_):
     """A frame file was written, with the AO of before this frame: write it again."""
-    if _helper_rendering():
+    state = session.current
+    if state.helper_rendering():
         return
     frame = scene.frame_current
     if not bpy.app.background:
@@ -151,12 +140,12 @@ def _on_render_write(scene, *_):
         # next frame renders. This thread (the render thread) waits while the main thread saves
         # them; the rest is done after the job.
         try:
-            main_thread.call(_save_written_frame, scene.name, frame)
+            state.main_thread.call(_save_written_frame, scene.name, frame)
         except Exception as error:
             report(f"{scene.name} frame {frame}: saving the passes failed, the file keeps the AO "
                    f"of the frame before: {error}", error=True)
         return
-    entry = _recomposited.pop((scene.name, frame), None)
+    entry = state.recomposited.pop((scene.name, frame), None)
     if entry is None:
         return
     passes, layers = entry
@@ -189,7 +178,8 @@ def _save_written_frame(scene_name, frame):
         return
     passes = recomposite.passes_path(scene, frame)
     recomposite.save_passes(scene, passes)
-    _written_frames.append((scene.name, frame, _written_output(scene, frame), passes))
+    session.current.written_frames.append((scene.name, frame, _written_output(scene, frame),
+                                           passes))
 
 
 # Blender keeps one process-wide "no data-block writes" flag, set around read-only Python
@@ -200,12 +190,11 @@ def _save_written_frame(scene_name, frame):
 # were then written without AO). Writes to the window manager are always allowed, and Blender
 # allows every write inside a Python property's update callback: the timers' work runs there.
 _WRITES_PROPERTY = "ssao_compositor_timer_tick"
-_with_writes = {"run": None}  # what the property's update callback runs
 
 
 def _run_with_writes(_window_manager, _context):
-    if _with_writes["run"] is not None:
-        _with_writes["run"]()
+    if session.current.run_with_writes is not None:
+        session.current.run_with_writes()
 
 
 def with_writes(function):
@@ -218,13 +207,14 @@ def with_writes(function):
         except Exception as error:  # raised again below, outside Blender's callback
             outcome["error"] = error
 
-    previous, _with_writes["run"] = _with_writes["run"], run
+    state = session.current
+    previous, state.run_with_writes = state.run_with_writes, run
     try:
         window_manager = bpy.context.window_manager
         tick = getattr(window_manager, _WRITES_PROPERTY)
         setattr(window_manager, _WRITES_PROPERTY, (tick + 1) % 1000000)
     finally:
-        _with_writes["run"] = previous
+        state.run_with_writes = previous
     if not outcome:  # no update callback (the property is gone): try as it is
         run()
     if "error" in outcome:
@@ -238,19 +228,20 @@ def _process_pending():
     the job, every frame's AO. This timer polls from register() on (often during a render: the
     render thread waits on it) and must never raise, or Blender drops it."""
     rendering = False
+    state = session.current
     try:
-        if main_thread.pending():
-            with_writes(main_thread.serve)
+        if state.main_thread.pending():
+            with_writes(state.main_thread.serve)
         else:
-            main_thread.serve()  # no work: only the render thread's sign of life
+            state.main_thread.serve()  # no work: only the render thread's sign of life
         rendering = bpy.app.is_job_running('RENDER')
-        if not rendering and (_written_frames or _pending_frames):
+        if not rendering and (state.written_frames or state.pending_frames):
             with_writes(_finish_rendered_frames)
-        if helper_process.busy():
+        if state.helpers_busy():
             _poll_helpers()
     except Exception as error:
         report(f"after the render: {error}", error=True)
-    return 0.05 if rendering else 0.1 if helper_process.busy() else 0.2
+    return 0.05 if rendering else 0.1 if state.helpers_busy() else 0.2
 
 
 def _poll_helpers():
@@ -274,12 +265,13 @@ def _answered(scene, frame):
 
 
 def _finish_rendered_frames():
-    if _written_frames:
+    state = session.current
+    if state.written_frames:
         # Outside a render handler the helper scene can go: the next one copies the compositor
         # as it is now (before 5.0 a scene's tree cannot be swapped, only copied with it).
         recomposite.remove_helpers()
-    while _written_frames:
-        scene_name, frame, output, passes = _written_frames.pop(0)
+    while state.written_frames:
+        scene_name, frame, output, passes = state.written_frames.pop(0)
         scene = bpy.data.scenes.get(scene_name)
         if scene is None or output is None:
             _remove(passes)
@@ -288,7 +280,7 @@ def _finish_rendered_frames():
         current = scene.frame_current
         try:
             scene.frame_set(frame)
-            aos = compute.compute_frame(scene, frame, _render_started)
+            aos = compute.compute_frame(scene, frame, state.render_started)
             # Written again even when every node failed: the file has the AO of the frame
             # before, and must get none (the failed nodes' AO is now 1).
             if aos:
@@ -300,8 +292,8 @@ def _finish_rendered_frames():
         finally:
             scene.frame_set(current)
             _remove(passes)
-    last = _pending_frames[-1] if _pending_frames else None
-    _pending_frames.clear()
+    last = state.pending_frames[-1] if state.pending_frames else None
+    state.pending_frames.clear()
     scene = bpy.data.scenes.get(last[0]) if last else None
     if scene is None or not compute.ssao_nodes(scene):
         return
@@ -318,7 +310,8 @@ def _show_frame(scene, frame):
     try:
         if frame != current:
             scene.frame_set(frame)
-        aos = compute.compute_frame(scene, frame, _render_started, outcome="shown",
+        aos = compute.compute_frame(scene, frame, session.current.render_started,
+                                    outcome="shown",
                                     wait=frame != current)
     finally:
         if scene.frame_current != current:
@@ -337,16 +330,14 @@ def _show_frame(scene, frame):
             report(message)
 
 
-_nudge = {"scene": None, "tries": 0, "composited": False}
-
-
 def nudge_until_composited(scene):
     """Nudges the scene's SSAO nodes so that the UI compositor runs again; then, when the
     compositor jobs of the moment are over, once more (one of them may have started before the
     new AO was in place: measured in 3.4 under load), and again while no job starts (right
     after a short render the nudge can be lost: measured in 5.2.2 after a 0.5 s render)."""
     _nudge_nodes(scene)
-    _nudge.update(scene=scene.name, tries=0, composited=False)
+    state = session.current
+    state.nudge_scene, state.nudge_tries, state.nudge_composited = scene.name, 0, False
     if _compositor_editor_open() and not bpy.app.timers.is_registered(_check_nudge):
         bpy.app.timers.register(_check_nudge, first_interval=0.3)
 
@@ -357,22 +348,23 @@ def _nudge_nodes(scene):
 
 
 def _check_nudge():
-    scene = bpy.data.scenes.get(_nudge["scene"] or "")
-    if scene is None or _nudge["tries"] >= 4:
+    state = session.current
+    scene = bpy.data.scenes.get(state.nudge_scene or "")
+    if scene is None or state.nudge_tries >= 4:
         return None
     if bpy.app.is_job_running('COMPOSITE'):
         return 0.2
-    if _nudge["tries"] > 0 and _nudge["composited"]:
+    if state.nudge_tries > 0 and state.nudge_composited:
         return None
-    _nudge["tries"] += 1
-    _nudge["composited"] = False
+    state.nudge_tries += 1
+    state.nudge_composited = False
     with_writes(lambda: _nudge_nodes(scene))
     return 0.5
 
 
 @bpy.app.handlers.persistent
 def _on_composite_pre(*_):
-    _nudge["composited"] = True
+    session.current.nudge_composited = True
 
 
 def _compositor_editor_open():
@@ -387,7 +379,8 @@ def _compositor_editor_open():
 
 def parameter_changed(node, scene):
     """A node property changed: recompute from the last export, then re-composite (UI)."""
-    if _helper_rendering() or saved_form.is_restoring() or bpy.app.background or \
+    state = session.current
+    if state.helper_rendering() or state.restoring_settings or bpy.app.background or \
             scene is None:
         return
     path = inner_tree.export_path(node, scene.frame_current)
@@ -469,7 +462,7 @@ def register():
     setattr(bpy.types.WindowManager, _WRITES_PROPERTY, bpy.props.IntProperty(
         options={'HIDDEN', 'SKIP_SAVE'}, update=_run_with_writes))
     if not bpy.app.background:
-        main_thread.start()
+        session.current.main_thread.start()
         bpy.app.timers.register(_process_pending, first_interval=0.2, persistent=True)
     # Nodes of a file that is already open (enabling the add-on after loading).
     try:
@@ -479,7 +472,8 @@ def register():
 
 
 def unregister():
-    main_thread.stop()  # a render thread waiting for the timer goes on without its work
+    # A render thread waiting for the timer goes on without its work.
+    session.current.main_thread.stop()
     helper_process.cancel()
     for timer in (_process_pending, _check_nudge):
         if bpy.app.timers.is_registered(timer):

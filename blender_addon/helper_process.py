@@ -17,7 +17,8 @@ In the UI the add-on asks (layers_or_request()) rather than renders; the main-th
 same node, once it has not changed for SETTLE seconds (dragging the band's slider starts none
 until it stops); it cancels the renders no request wants any more, and hands the finished
 layers to hidden_surfaces' cache. A new render of the scene cancels its helpers
-(cancel()): their layers would be of the render before."""
+(cancel()): their layers would be of the render before. Requests, renders and failures are kept
+in the session (session.py)."""
 import atexit
 import json
 import os
@@ -30,18 +31,10 @@ import time
 import bpy
 import numpy as np
 
-from . import hidden_surfaces
+from . import hidden_surfaces, session
 
 SETTLE = 0.25  # seconds a request that replaced another stays unchanged before it starts
 LOG_TAIL = 12  # lines of a failed helper's output quoted in the error
-
-enabled = True  # set by preferences.py: False renders in Blender's own process, as headless
-renders_started = 0  # helper processes started in this session (tests count them)
-
-_lock = threading.Lock()  # cancel() runs in the render thread (render_pre in the UI)
-_requests = {}  # (scene name, requester) -> _Request
-_renders = {}   # (scene name, key) -> _Render
-_failed = {}    # (scene name, key) -> error message, until the scene renders again
 
 # Run by the helper process, after Blender opened the scene's copy.
 _CHILD = r"""
@@ -89,7 +82,6 @@ class _Render:
             raise
 
     def _start(self, scene, hits, overscan):
-        global renders_started
         blend = os.path.join(self.folder, "scene.blend")
         bpy.data.libraries.write(blend, {scene}, path_remap='ABSOLUTE', compress=False)
         self.output = os.path.join(self.folder, "layers.npz")
@@ -111,7 +103,7 @@ class _Render:
             self.process = subprocess.Popen(
                 command, stdin=subprocess.DEVNULL, stdout=log, stderr=subprocess.STDOUT,
                 cwd=self.folder, creationflags=getattr(subprocess, "CREATE_NO_WINDOW", 0))
-        renders_started += 1
+        session.current.helpers_started += 1
 
     def poll(self):
         """False while it runs; True when self.layers or self.error is set."""
@@ -176,30 +168,35 @@ def layers_or_request(scene, hits, overscan, requester):
     layers = hidden_surfaces.kept_layers(scene.name, key)
     if layers is not None:
         return layers
-    with _lock:
-        error = _failed.get((scene.name, key))
+    state = session.current
+    with state.helper_lock:
+        error = state.helper_failed.get((scene.name, key))
         if error is not None:
             raise RuntimeError(error)
-        asked = _requests.get((scene.name, requester))
+        asked = state.helper_requests.get((scene.name, requester))
         if asked is None or asked.key != key:
-            _requests[(scene.name, requester)] = _Request(key, hits, overscan,
-                                                          replacing=asked is not None)
+            state.helper_requests[(scene.name, requester)] = _Request(
+                key, hits, overscan, replacing=asked is not None)
     return None
 
 
 def withdraw(scene_name, requester):
     """`requester` needs no layers any more (its settings changed)."""
-    with _lock:
-        _requests.pop((scene_name, requester), None)
+    state = session.current
+    with state.helper_lock:
+        state.helper_requests.pop((scene_name, requester), None)
 
 
 def waiting(scene_name, requester):
     """Whether `requester` waits for layers of scene `scene_name`."""
-    return (scene_name, requester) in _requests
+    return (scene_name, requester) in session.current.helper_requests
 
 
-def busy():
-    return bool(_requests or _renders)
+def running():
+    """The helper renders running now (tests look at their processes)."""
+    state = session.current
+    with state.helper_lock:
+        return list(state.helper_renders.values())
 
 
 def poll():
@@ -209,13 +206,15 @@ def poll():
     (layers kept, an error recorded, or dropped: the scene changed): compute them again."""
     answered = {}
     rendering = bpy.app.is_job_running('RENDER')  # a new render cancels these anyway
-    with _lock:
-        wanted = {(scene, request.key) for (scene, _), request in _requests.items()}
-        for id_ in [i for i in _renders if i not in wanted]:
-            _renders.pop(id_).cancel()
+    state = session.current
+    requests, renders = state.helper_requests, state.helper_renders
+    with state.helper_lock:
+        wanted = {(scene, request.key) for (scene, _), request in requests.items()}
+        for id_ in [i for i in renders if i not in wanted]:
+            renders.pop(id_).cancel()
         now = time.monotonic()
-        due = {(scene, request.key): request for (scene, _), request in _requests.items()
-               if now >= request.due and (scene, request.key) not in _renders}
+        due = {(scene, request.key): request for (scene, _), request in requests.items()
+               if now >= request.due and (scene, request.key) not in renders}
     for (scene_name, _), request in due.items() if not rendering else ():
         scene = bpy.data.scenes.get(scene_name)
         if scene is None or hidden_surfaces.layers_key(
@@ -231,14 +230,14 @@ def poll():
             _answer(scene_name, request.key, error=f"starting the helper render failed: {error}")
             answered[scene_name] = request.key[0]
             continue
-        with _lock:
-            _renders[(scene_name, request.key)] = render
-    with _lock:
-        running = list(_renders.items())
-    for (scene_name, key), render in running:
+        with state.helper_lock:
+            renders[(scene_name, request.key)] = render
+    with state.helper_lock:
+        started = list(renders.items())
+    for (scene_name, key), render in started:
         if render.poll():
-            with _lock:
-                _renders.pop((scene_name, key), None)
+            with state.helper_lock:
+                renders.pop((scene_name, key), None)
             _answer(scene_name, key, render.layers, render.error)
             answered[scene_name] = key[0]
     return answered
@@ -248,25 +247,29 @@ def _answer(scene_name, key, layers=None, error=None):
     if layers is not None:
         hidden_surfaces.keep(scene_name, key, layers)
     else:
-        with _lock:
-            _failed[(scene_name, key)] = error
+        state = session.current
+        with state.helper_lock:
+            state.helper_failed[(scene_name, key)] = error
     _drop_requests(scene_name, key)
 
 
 def _drop_requests(scene_name, key):
-    with _lock:
-        for id_ in [i for i, r in _requests.items() if i[0] == scene_name and r.key == key]:
-            del _requests[id_]
+    state = session.current
+    with state.helper_lock:
+        requests = state.helper_requests
+        for id_ in [i for i, r in requests.items() if i[0] == scene_name and r.key == key]:
+            del requests[id_]
 
 
 def cancel(scene_name=None):
     """Forgets the requests, renders and failures of `scene_name` (every scene with None): it
     renders again. Safe from any thread."""
-    with _lock:
-        for table in (_requests, _renders, _failed):
+    state = session.current
+    with state.helper_lock:
+        for table in (state.helper_requests, state.helper_renders, state.helper_failed):
             for id_ in [i for i in table if scene_name is None or i[0] == scene_name]:
                 item = table.pop(id_)
-                if table is _renders:
+                if table is state.helper_renders:
                     item.cancel()
 
 

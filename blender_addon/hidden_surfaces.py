@@ -29,7 +29,7 @@ import mathutils
 import numpy as np
 
 from . import camera as camera_module
-from . import compat, multilayer
+from . import compat, multilayer, session
 
 HELPER_PREFIX = ".SSAO layers "
 LAYER_NAME = "SSAO layers"
@@ -45,24 +45,17 @@ OPEN_SAMPLES = 1
 EXTRA_SLOTS = 1
 OPEN_DISTANCE = 1e4
 BACKGROUND = 1e10  # Cycles' Depth pass where there is no surface, Blender's convention
-
-_running = False  # our helper render fires the render handlers too
-# scene name -> {settings: layers}: one render serves every recompute of that frame (and each
-# of several nodes with other settings gets its own)
-_cache = {}
+# Layers kept per scene (session.current.kept_layers): one render serves every recompute of that
+# frame, and each of several nodes with other settings gets its own.
 CACHED_PER_SCENE = 2
-
-
-def is_running():
-    return _running
 
 
 def forget(scene_name=None):
     """Drops the layers kept for `scene_name` (all with None): a new render of it is coming."""
     if scene_name is None:
-        _cache.clear()
+        session.current.kept_layers.clear()
     else:
-        _cache.pop(scene_name, None)
+        session.current.kept_layers.pop(scene_name, None)
 
 
 def _slots(hits):
@@ -485,12 +478,8 @@ def _render_settings(scene, helper, hits, overscan):
 
 def _render(helper, path):
     """Renders the helper and saves its Render Result (each scene has its own) to `path`."""
-    global _running
-    _running = True
-    try:
+    with session.current.doing("rendering_layers"):  # the render fires the render handlers
         bpy.ops.render.render(scene=helper.name)
-    finally:
-        _running = False
     result = bpy.data.images.get("Render Result")
     if result is None:
         raise RuntimeError("the hidden-surface render made no Render Result")
@@ -589,12 +578,12 @@ def layers_key(scene, hits, overscan):
 
 def kept_layers(scene_name, key):
     """The layers rendered for `key` (layers_key) and kept, or None."""
-    return _cache.get(scene_name, {}).get(key)
+    return session.current.kept_layers.get(scene_name, {}).get(key)
 
 
 def keep(scene_name, key, layers):
     """Keeps `layers` for `key` until forget(); the oldest go beyond CACHED_PER_SCENE."""
-    cached = _cache.setdefault(scene_name, {})
+    cached = session.current.kept_layers.setdefault(scene_name, {})
     while len(cached) >= CACHED_PER_SCENE:  # an animation's frames must not pile up
         cached.pop(next(iter(cached)))
     cached[key] = layers

@@ -34,81 +34,79 @@ class _Call:
         self.done = threading.Event()
 
 
-_lock = threading.Lock()     # guards _queue, _last_served, _closed and every call's state
-_queue = []
-_last_served = 0.0           # time.monotonic() of the main thread's last serve()
-_closed = True               # no timer serves: before register(), after unregister()
-
-
 def on_main_thread():
     return threading.current_thread() is threading.main_thread()
 
 
-def call(function, *args):
-    """function(*args) on the main thread; returns its result or raises its exception. On the
-    main thread itself (a blocking render from a script) it is called at once."""
-    if on_main_thread():
-        return function(*args)
-    work = _Call(function, args)
-    with _lock:
-        if _closed:
-            raise Abandoned("the add-on's main-thread timer is not running")
-        _queue.append(work)
-    while not work.done.wait(0.1):  # releases the GIL while it waits
-        with _lock:
-            if work.state != _PENDING:
-                continue  # taken: the main thread is doing it now
-            silent = time.monotonic() - max(_last_served, work.asked)
-            if silent <= STALL_LIMIT and not _closed:
-                continue
-            work.state = _ABANDONED
-            _queue.remove(work)
-        raise Abandoned(f"Blender's main thread did not answer for {silent:.0f} s"
-                        if silent > STALL_LIMIT else "the add-on was disabled")
-    if work.error is not None:
-        raise work.error
-    return work.result
+class Handover:
+    """The queue between the render thread and the main thread's timer (session.py holds the
+    add-on's one)."""
 
+    def __init__(self):
+        self._lock = threading.Lock()  # guards the fields below and every call's state
+        self._queue = []
+        self._last_served = 0.0  # time.monotonic() of the main thread's last serve()
+        self._closed = True      # no timer serves: before start(), after stop()
 
-def pending():
-    """True when work waits for serve()."""
-    with _lock:
-        return bool(_queue)
+    def call(self, function, *args):
+        """function(*args) on the main thread; returns its result or raises its exception. On
+        the main thread itself (a blocking render from a script) it is called at once."""
+        if on_main_thread():
+            return function(*args)
+        work = _Call(function, args)
+        with self._lock:
+            if self._closed:
+                raise Abandoned("the add-on's main-thread timer is not running")
+            self._queue.append(work)
+        while not work.done.wait(0.1):  # releases the GIL while it waits
+            with self._lock:
+                if work.state != _PENDING:
+                    continue  # taken: the main thread is doing it now
+                silent = time.monotonic() - max(self._last_served, work.asked)
+                if silent <= STALL_LIMIT and not self._closed:
+                    continue
+                work.state = _ABANDONED
+                self._queue.remove(work)
+            raise Abandoned(f"Blender's main thread did not answer for {silent:.0f} s"
+                            if silent > STALL_LIMIT else "the add-on was disabled")
+        if work.error is not None:
+            raise work.error
+        return work.result
 
+    def pending(self):
+        """True when work waits for serve()."""
+        with self._lock:
+            return bool(self._queue)
 
-def serve():
-    """Main thread: does every queued piece of work, in the order asked."""
-    global _last_served
-    with _lock:
-        _last_served = time.monotonic()
-        taken = list(_queue)
-        _queue.clear()
+    def serve(self):
+        """Main thread: does every queued piece of work, in the order asked."""
+        with self._lock:
+            self._last_served = time.monotonic()
+            taken = list(self._queue)
+            self._queue.clear()
+            for work in taken:
+                work.state = _TAKEN
         for work in taken:
-            work.state = _TAKEN
-    for work in taken:
-        try:
-            work.result = work.function(*work.args)
-        except Exception as error:  # handed to the waiting thread
-            work.error = error
-        finally:
-            work.done.set()
+            try:
+                work.result = work.function(*work.args)
+            except Exception as error:  # handed to the waiting thread
+                work.error = error
+            finally:
+                work.done.set()
 
+    def start(self):
+        """register(): the timer serves from now on."""
+        with self._lock:
+            self._closed = False
+            self._last_served = time.monotonic()
 
-def start():
-    """register(): the timer serves from now on."""
-    global _closed, _last_served
-    with _lock:
-        _closed = False
-        _last_served = time.monotonic()
-
-
-def stop():
-    """unregister(): no timer serves any more; queued work is abandoned, waiting threads go."""
-    global _closed
-    with _lock:
-        _closed = True
-        for work in _queue:
-            work.state = _ABANDONED
-            work.error = Abandoned("the add-on was disabled")
-            work.done.set()
-        _queue.clear()
+    def stop(self):
+        """unregister(): no timer serves any more; queued work is abandoned, waiting threads
+        go."""
+        with self._lock:
+            self._closed = True
+            for work in self._queue:
+                work.state = _ABANDONED
+                work.error = Abandoned("the add-on was disabled")
+                work.done.set()
+            self._queue.clear()

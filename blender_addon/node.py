@@ -3,14 +3,8 @@
 whose properties are libssao's parameters, with the library's names, defaults and ranges."""
 import bpy
 
-from . import compat, compute, handlers, inner_tree, recomposite, saved_form, ssao
+from . import compat, compute, handlers, inner_tree, session, ssao
 
-# Why the library's parameter table could not be read (shown on the node), or None.
-LIBRARY_ERROR = None
-# Variant name -> the parameters only it reads (the node hides them for other variants).
-VARIANT_PARAMETERS = {}
-# Parameter name -> its library group (ssao_param_group: compute.NODE_GROUPS), for the sidebar.
-PARAMETER_GROUPS = {}
 # The node's face (draw_buttons): what an artist changes, as on Blender's own nodes; with the
 # add-on's settings (compute.NODE_SETTINGS), Recompute and the status. The sidebar (N panel,
 # Node tab: draw_buttons_ext) shows every property, grouped as the library groups them.
@@ -33,7 +27,7 @@ def _on_parameter_changed(node, context):
 def _on_overscan_changed(node, context):
     # A band given in pixels (from the UI or a script: node.overscan = 16) is used as given;
     # a saved file's settings put back (saved_form.py) keep their own overscan_mode.
-    if node.overscan_mode != 'PIXELS' and not saved_form.is_restoring():
+    if node.overscan_mode != 'PIXELS' and not session.current.restoring_settings:
         node.overscan_mode = 'PIXELS'  # its own update recomputes
         return
     _on_parameter_changed(node, context)
@@ -78,16 +72,14 @@ def _draw_property(node, layout, name, stacked=False):
 
 
 def _parameter_table():
-    global LIBRARY_ERROR
+    """The library's parameters the node shows, {name: description}; {} without the library
+    (the error is kept in the session and shown on the node)."""
     try:
-        table = {p["name"]: p for p in ssao.parameters(compute.library())}
-        PARAMETER_GROUPS.update({name: p["group"] for name, p in table.items()})
-        VARIANT_PARAMETERS.update({v["name"]: set(v["parameters"])
-                                   for v in ssao.variants(compute.library())})
+        table = compute.library_table()
     except Exception as error:  # the node must still register so .blend files open
-        LIBRARY_ERROR = str(error)
+        session.current.library_error = str(error)
         return {}
-    return {name: table[name] for name in compute.node_parameter_names()}
+    return {name: table.parameters[name] for name in table.node_parameter_names}
 
 
 class CompositorNodeSSAO(bpy.types.CompositorNodeCustomGroup):
@@ -136,7 +128,7 @@ class CompositorNodeSSAO(bpy.types.CompositorNodeCustomGroup):
         # The re-compositing helper's copy shares the inner tree and AO image (it composites
         # with that AO); any other copy (Shift+D, a scene's Full Copy) gets its own id, inner
         # tree and AO image, or the two would overwrite each other's export and AO.
-        if recomposite.is_copying_helper():
+        if session.current.copying_helper:
             return
         self.ssao_id = inner_tree.new_id()
         self.node_tree = node.node_tree.copy() if node.node_tree is not None else \
@@ -151,16 +143,17 @@ class CompositorNodeSSAO(bpy.types.CompositorNodeCustomGroup):
     def shown_parameters(self):
         """The library parameters the node shows, in the table's order: those its variant
         reads (the library lists them, ssao_variant_info) and those every variant reads."""
-        if LIBRARY_ERROR:
+        if session.current.library_error:
             return []
-        variant_specific = set().union(*VARIANT_PARAMETERS.values())
-        active = VARIANT_PARAMETERS.get(getattr(self, "variant", ""), variant_specific)
+        variants = compute.library_table().variant_parameters
+        variant_specific = set().union(*variants.values())
+        active = variants.get(getattr(self, "variant", ""), variant_specific)
         return [name for name in compute.node_parameter_names()
                 if name in self.bl_rna.properties and
                 (name not in variant_specific or name in active)]
 
     def _draw_problems(self, context, layout):
-        if LIBRARY_ERROR:
+        if session.current.library_error:
             layout.label(text="libssao missing (see console)", icon='ERROR')
         problem = context.scene and compat.compositor_cannot_export(context.scene)
         if problem:
@@ -194,9 +187,11 @@ class CompositorNodeSSAO(bpy.types.CompositorNodeCustomGroup):
         self._draw_problems(context, layout)
         shown = self.shown_parameters()
         groups = list(compute.NODE_GROUPS)
-        groups += sorted({PARAMETER_GROUPS.get(name, "") for name in shown} - set(groups))
+        table = compute.library_table().parameters if shown else {}
+        group_of = {name: table[name]["group"] for name in shown}
+        groups += sorted(set(group_of.values()) - set(groups))
         for group in groups:  # a group the add-on does not know yet comes after its own
-            names = [name for name in shown if PARAMETER_GROUPS.get(name, "") == group]
+            names = [name for name in shown if group_of[name] == group]
             if names:
                 box = layout.box()
                 box.label(text=GROUP_TITLES.get(group, group.capitalize() or "Other"))
@@ -229,8 +224,8 @@ def register():
     else:
         print("ssao_compositor: warning: no compositor Filter menu found; add the node from "
               "Python: tree.nodes.new('CompositorNodeSSAO')")
-    if LIBRARY_ERROR:
-        print(f"ssao_compositor: error: {LIBRARY_ERROR}")
+    if session.current.library_error:
+        print(f"ssao_compositor: error: {session.current.library_error}")
 
 
 def unregister():

@@ -2,16 +2,16 @@
 """The add-on's preferences: where the passes are exported, and what the library says."""
 import bpy
 
-from . import compute, handlers, helper_process
+from . import compute, handlers, session
 
 
 def _on_export_dir_changed(preferences, context):
-    compute.preferred_export_dir = bpy.path.abspath(preferences.export_dir)
+    session.current.export_dir = bpy.path.abspath(preferences.export_dir)
     handlers.set_up_nodes()
 
 
 def _on_helper_process_changed(preferences, context):
-    helper_process.enabled = preferences.helper_process
+    session.current.use_helper_process = preferences.helper_process
 
 
 class SSAOPreferences(bpy.types.AddonPreferences):
@@ -49,8 +49,8 @@ def register():
     bpy.utils.register_class(SSAOPreferences)
     addon = bpy.context.preferences.addons.get(__package__)
     if addon is not None and addon.preferences is not None:
-        compute.preferred_export_dir = bpy.path.abspath(addon.preferences.export_dir)
-        helper_process.enabled = addon.preferences.helper_process
+        session.current.export_dir = bpy.path.abspath(addon.preferences.export_dir)
+        session.current.use_helper_process = addon.preferences.helper_process
 
 
 def unregister():

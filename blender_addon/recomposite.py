@@ -9,10 +9,9 @@ import os
 
 import bpy
 
-from . import compat, compute, inner_tree, multilayer
+from . import compat, compute, inner_tree, multilayer, session
 
 HELPER_PREFIX = compute.HELPER_SCENE_PREFIX
-_copying_helper = False  # see is_copying_helper()
 PASSES_IMAGE_PREFIX = ".SSAO passes "
 
 
@@ -58,24 +57,17 @@ def helper_scene(scene):
     """The hidden copy of `scene` that re-composites it. Kept and reused (removing a scene in a
     render handler crashes); in 5.x its compositing tree, a data-block the copy would share, is
     copied afresh each time so that it follows the scene's."""
-    global _copying_helper
     name = HELPER_PREFIX + scene.name
     helper = bpy.data.scenes.get(name)
     if helper is None:
-        _copying_helper = True
-        try:
+        with session.current.doing("copying_helper"):  # the copy's SSAO nodes share AO
             helper = scene.copy()
-        finally:
-            _copying_helper = False
         helper.name = name
         helper.use_fake_user = False
     if compat.compositor_trees_are_shared():
         old = compat.compositor_tree(helper)
-        _copying_helper = True
-        try:
+        with session.current.doing("copying_helper"):
             copy = compat.compositor_tree(scene).copy()
-        finally:
-            _copying_helper = False
         copy.name = HELPER_PREFIX + scene.name
         compat.set_compositor_tree(helper, copy)
         if old is not None and old != compat.compositor_tree(scene) and old.users == 0:
@@ -88,12 +80,6 @@ def helper_scene(scene):
         setattr(helper.view_settings, attribute, getattr(scene.view_settings, attribute))
     helper.display_settings.display_device = scene.display_settings.display_device
     return helper
-
-
-def is_copying_helper():
-    """True while the helper scene (or its tree) is being copied: its SSAO nodes share their
-    inner tree and AO image with the scene's."""
-    return _copying_helper
 
 
 def helper_scene_if_any(scene):
@@ -129,38 +115,29 @@ def _read_passes_from(helper, path, source_scene):
         tree.nodes.remove(rl)
 
 
-_running = False  # our own helper render fires the render handlers again
-
-
-def is_running():
-    return _running
-
-
 def recomposite(scene, path):
     """Re-runs only the compositor of `scene` on the passes saved at `path`; returns the helper
     scene, whose Render Result is the new composite."""
-    global _running
     helper = helper_scene(scene)
     _read_passes_from(helper, path, scene)
     nodes = [node for _, node in compute.all_ssao_nodes()]
-    _running = True
-    for node in nodes:
-        inner_tree.set_exporter_muted(node, True)
     # A one-frame animation, not a still: File Output nodes downstream of the SSAO node then
     # write their frame's file again, named as in the render (5.x names a still's files without
     # the frame number). The helper's own frame file goes to a temporary name, then away.
     frame = scene.frame_current
     helper.frame_start = helper.frame_end = helper.frame_current = frame
     helper.render.filepath = os.path.join(compute.export_dir(), "recomposite_####")
-    try:
-        bpy.ops.render.render(animation=True, scene=helper.name)
-        written = helper.render.frame_path(frame=frame)
-        if os.path.isfile(written):
-            os.remove(written)
-    finally:
-        for node in nodes:
-            inner_tree.set_exporter_muted(node, False)
-        _running = False
+    with session.current.doing("recompositing"):  # the render fires the render handlers again
+        try:
+            for node in nodes:
+                inner_tree.set_exporter_muted(node, True)
+            bpy.ops.render.render(animation=True, scene=helper.name)
+            written = helper.render.frame_path(frame=frame)
+            if os.path.isfile(written):
+                os.remove(written)
+        finally:
+            for node in nodes:
+                inner_tree.set_exporter_muted(node, False)
     return helper
 
 

@@ -7,17 +7,12 @@ tree. The add-on turns the group nodes back into SSAO nodes when a file loads or
 enabled, and turns its nodes into group nodes just before saving and back just after."""
 import bpy
 
-from . import compute, inner_tree
+from . import compute, inner_tree, session
 
 SETTINGS_KEY = "ssao_compositor"  # the ID property on the group node
 # On an SSAO node: settings this add-on could not apply (a setting it does not have, or all of
 # them while libssao is missing), kept for the next save.
 UNAPPLIED_KEY = "ssao_compositor_unapplied"
-_restoring = False                # no recompute while settings are put back
-
-
-def is_restoring():
-    return _restoring
 
 
 def _replace(old, idname):
@@ -70,7 +65,6 @@ def to_group_node(node):
 
 def from_group_node(group):
     """The group node `group` (made by to_group_node), replaced by an SSAO node again."""
-    global _restoring
     settings = dict(group[SETTINGS_KEY])
     inner = group.node_tree
     tree, node = _replace(group, inner_tree.NODE_IDNAME)
@@ -81,17 +75,14 @@ def from_group_node(group):
         bpy.data.node_groups.remove(fresh_tree)
     if fresh_image is not None and fresh_image.users == 0:
         bpy.data.images.remove(fresh_image)
-    _restoring = True
     unapplied = {}
-    try:
+    with session.current.doing("restoring_settings"):  # no recompute per setting
         node.ssao_id = settings.pop("ssao_id", node.ssao_id)
         for name, value in settings.items():
             try:
                 setattr(node, name, value)
             except (AttributeError, TypeError, ValueError):
                 unapplied[name] = value
-    finally:
-        _restoring = False
     if unapplied:
         node[UNAPPLIED_KEY] = unapplied
     _relink(tree, group, node)

@@ -6,7 +6,9 @@ on the open .blend, in background Blender (the UI polls it from a timer; here a 
   - "settled": a request replaced before it settles starts no process (only the last one);
   - "cancelled": cancel() kills a running helper process and removes its files;
   - "failure": a helper that fails (a scene without a camera) gives its error, with the
-    child's own message, until the scene renders again (cancel()).
+    child's own message, until the scene renders again (cancel());
+  - "disabled": disabling the add-on kills a running helper process, and enabling it again
+    begins a session (session.py) that remembers nothing of the last.
 Writes --out JSON with those results.
 
     blender -b --factory-startup --addons ssao_compositor SCENE.blend \\
@@ -19,6 +21,7 @@ import os
 import sys
 import time
 
+import addon_utils
 import bpy
 import numpy as np
 
@@ -32,6 +35,7 @@ def addon_module(name):
 
 helper_process = addon_module("helper_process")
 hidden_surfaces = addon_module("hidden_surfaces")
+session = addon_module("session")
 
 
 def poll_until(condition):
@@ -55,13 +59,13 @@ def main():
     result = {}
 
     # A request replaced before it settles: only the second starts a process.
-    started = helper_process.renders_started
+    started = session.current.helpers_started
     assert helper_process.layers_or_request(scene, hits, 8, "node") is None
     assert helper_process.layers_or_request(scene, hits, overscan, "node") is None
     start = time.monotonic()
     answered = poll_until(bool)
     result["seconds"] = time.monotonic() - start
-    result["settled"] = {"processes": helper_process.renders_started - started,
+    result["settled"] = {"processes": session.current.helpers_started - started,
                          "answered": answered}
     background = helper_process.layers_or_request(scene, hits, overscan, "node")
     hidden_surfaces.forget()
@@ -77,12 +81,12 @@ def main():
     # Cancelled while it runs.
     hidden_surfaces.forget()
     assert helper_process.layers_or_request(scene, hits, overscan, "node") is None
-    poll_until(lambda _: helper_process._renders)
-    render = next(iter(helper_process._renders.values()))
+    poll_until(lambda _: helper_process.running())
+    render = helper_process.running()[0]
     helper_process.cancel(scene.name)
     result["cancelled"] = {"exit": render.process.poll(),
                            "files_left": os.path.exists(render.folder),
-                           "busy": helper_process.busy()}
+                           "busy": session.current.helpers_busy()}
 
     # A helper that fails: its error, with the child's message, until the scene renders again.
     camera, scene.camera = scene.camera, None
@@ -98,6 +102,25 @@ def main():
         helper_process.layers_or_request(scene, hits, overscan, "node") is None
     helper_process.cancel(scene.name)
     scene.camera = camera
+
+    # The add-on disabled while a helper renders: the process is killed and its files go;
+    # enabled again, a new session remembers nothing of the old one.
+    hidden_surfaces.keep(scene.name, "kept before", here)
+    assert helper_process.layers_or_request(scene, hits, overscan, "node") is None
+    poll_until(lambda _: helper_process.running())
+    render = helper_process.running()[0]
+    old = session.current
+    package = next(n for n in sys.modules if n.endswith("ssao_compositor"))
+    addon_utils.disable(package)
+    addon_utils.enable(package)
+    new = session.current
+    result["disabled"] = {"exit": render.process.poll(),
+                          "files_left": os.path.exists(render.folder),
+                          "new_session": new is not old,
+                          "remembered": [name for name in ("kept_layers", "helper_requests",
+                                                           "helper_renders", "helper_failed",
+                                                           "helpers_started")
+                                         if getattr(new, name)]}
 
     with open(args.out, "w") as f:
         json.dump(result, f, indent=1)

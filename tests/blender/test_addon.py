@@ -410,7 +410,9 @@ class AddonTest(unittest.TestCase):
         # on the scene with cut-outs, displacement and holdouts (materials given outputs of
         # their own, in the copy): its layers equal, bit for bit, those rendered in Blender's
         # process. A request replaced before it settles starts no process; a new render
-        # cancels a running one (killed, files removed); a failure carries the child's message.
+        # cancels a running one (killed, files removed); a failure carries the child's message;
+        # disabling the add-on kills a running one, and enabling it again begins a session
+        # that remembers nothing of the last (session.py).
         result = os.path.join(self.folder("helper_process"), "helper_process.json")
         blend = self.blender.build_scene("helper_process/scene", "--render-features",
                                          "--cutouts")
@@ -429,6 +431,8 @@ class AddonTest(unittest.TestCase):
                                                "busy": False}, report)
         self.assertIn("has no active camera", report["failure"])
         self.assertTrue(report["after_failure_asks_again"])
+        self.assertEqual(report["disabled"], {"exit": -signal.SIGKILL, "files_left": False,
+                                              "new_session": True, "remembered": []}, report)
 
     def test_render_border_with_crop(self):
         # A render cropped to its border: the passes are the crop's size, the AO is the crop's

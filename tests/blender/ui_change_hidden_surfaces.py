@@ -55,10 +55,13 @@ def finish(code):
 
 
 def busy():
-    handlers = addon_module("handlers")
-    return bpy.app.is_job_running('RENDER') or bool(handlers._pending_frames or
-                                                    handlers._written_frames) or \
-        addon_module("helper_process").busy()
+    return bpy.app.is_job_running('RENDER') or addon_module("session").current.busy()
+
+
+def set_helper_process(on):
+    """The add-on's preference "Helper render in its own process" (--addons enables the add-on
+    without an entry in the preferences, so it is set where the preference puts it)."""
+    addon_module("session").current.use_helper_process = on
 
 
 def f12():
@@ -75,12 +78,13 @@ def step():
             f12()
             STATE["step"] = 0
             return 1.0
-        helper_process = addon_module("helper_process")
-        if STATE["step"] == 0 and helper_process.enabled and STATE["stale"] is None:
+        state = addon_module("session").current
+        if STATE["step"] == 0 and state.use_helper_process and STATE["stale"] is None:
             # F12 again while the first F12's helper process renders: it must be cancelled.
-            if not helper_process._renders:
+            running = addon_module("helper_process").running()
+            if not running:
                 return 0.05
-            STATE["stale"] = next(iter(helper_process._renders.values())).process
+            STATE["stale"] = running[0].process
             f12()
             return 1.0
         if busy() or not node().status:
@@ -92,7 +96,7 @@ def step():
         STATE["report"].append({"step": STEPS[STATE["step"]][0], "status": n.status,
                                 "ao_mean": ao_mean(n),
                                 "helper_renders": STATE["helper_renders"] +
-                                helper_process.renders_started})
+                                state.helpers_started})
         if STATE["stale"] is not None:
             STATE["report"][-1]["stale_helper_exit"] = STATE["stale"].poll()
         STATE["step"] += 1
@@ -110,6 +114,6 @@ def step():
     return None
 
 
-addon_module("helper_process").enabled = "--in-process" not in ARGS
+set_helper_process("--in-process" not in ARGS)
 bpy.app.handlers.render_pre.append(count_helper_renders)
 bpy.app.timers.register(step, first_interval=2.0)

@@ -42,8 +42,8 @@ def addon_module(name):
 
 def addon_busy():
     """The add-on's main-thread timer still has frames to finish."""
-    handlers = addon_module("handlers")
-    return bool(handlers._written_frames or handlers._pending_frames)
+    state = addon_module("session").current
+    return bool(state.written_frames or state.pending_frames)
 
 
 def break_frame(frame):

@@ -42,10 +42,13 @@ def probe():
 
 
 def busy():
-    handlers = addon_module("handlers")
-    return bpy.app.is_job_running('RENDER') or bool(handlers._pending_frames or
-                                                    handlers._written_frames) or \
-        addon_module("helper_process").busy()
+    return bpy.app.is_job_running('RENDER') or addon_module("session").current.busy()
+
+
+def set_helper_process(on):
+    """The add-on's preference "Helper render in its own process" (--addons enables the add-on
+    without an entry in the preferences, so it is set where the preference puts it)."""
+    addon_module("session").current.use_helper_process = on
 
 
 def finish(code):
@@ -55,7 +58,7 @@ def finish(code):
     report = {"blender": bpy.app.version_string, "longest_stall_s": gaps[0] if gaps else None,
               "next_stalls_s": gaps[1:5], "f12_to_idle_s": (ticks[-1] - ticks[0]) if ticks
               else None, "status": nodes[0].status if nodes else "no active SSAO node",
-              "helper_processes": addon_module("helper_process").renders_started}
+              "helper_processes": addon_module("session").current.helpers_started}
     with open(REPORT, "w") as f:
         json.dump(report, f, indent=1)
     print(f"[measure] UI stall during F12: {report}", flush=True)
@@ -87,7 +90,7 @@ def step():
     return None
 
 
-addon_module("helper_process").enabled = "--in-process" not in ARGS
+set_helper_process("--in-process" not in ARGS)
 if "--keep-viewport" not in ARGS:
     for window in bpy.context.window_manager.windows:
         for area in window.screen.areas:

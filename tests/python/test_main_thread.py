@@ -18,44 +18,46 @@ import main_thread  # noqa: E402
 
 
 class Asker(threading.Thread):
-    """A render thread: main_thread.call(function, *args), keeping the outcome."""
+    """A render thread: handover.call(function, *args), keeping the outcome."""
 
-    def __init__(self, function, *args):
+    def __init__(self, handover, function, *args):
         super().__init__(daemon=True)
-        self.function, self.args = function, args
+        self.handover, self.function, self.args = handover, function, args
         self.result = self.error = None
         self.ended_at = None
 
     def run(self):
         try:
-            self.result = main_thread.call(self.function, *self.args)
+            self.result = self.handover.call(self.function, *self.args)
         except Exception as error:
             self.error = error
         self.ended_at = time.monotonic()
 
 
-def serve_until(condition, seconds=10.0):
+def serve_until(handover, condition, seconds=10.0):
     """The main thread's timer: serve() every 10 ms until condition() or the time is up."""
     end = time.monotonic() + seconds
     while not condition() and time.monotonic() < end:
-        main_thread.serve()
+        handover.serve()
         time.sleep(0.01)
 
 
 class MainThreadTest(unittest.TestCase):
     def setUp(self):
-        main_thread.start()
+        self.handover = main_thread.Handover()
+        self.handover.start()
         self.stall_limit = main_thread.STALL_LIMIT
 
     def tearDown(self):
-        main_thread.stop()
+        self.handover.stop()
         main_thread.STALL_LIMIT = self.stall_limit
 
     def test_work_runs_on_the_serving_thread_and_its_result_comes_back(self):
         ran_on = []
-        asker = Asker(lambda a, b: ran_on.append(threading.current_thread()) or a + b, 2, 3)
+        asker = Asker(self.handover,
+                      lambda a, b: ran_on.append(threading.current_thread()) or a + b, 2, 3)
         asker.start()
-        serve_until(lambda: asker.ended_at is not None)
+        serve_until(self.handover, lambda: asker.ended_at is not None)
         asker.join(5)
         self.assertEqual(asker.result, 5)
         self.assertIsNone(asker.error)
@@ -68,11 +70,11 @@ class MainThreadTest(unittest.TestCase):
             time.sleep(0.3)
             finished.append(time.monotonic())
 
-        asker = Asker(slow)
+        asker = Asker(self.handover, slow)
         asker.start()
         time.sleep(0.2)  # nobody serves yet: the asker must still wait
         self.assertTrue(asker.is_alive())
-        serve_until(lambda: asker.ended_at is not None)
+        serve_until(self.handover, lambda: asker.ended_at is not None)
         asker.join(5)
         self.assertEqual(len(finished), 1)
         self.assertGreaterEqual(asker.ended_at, finished[0])
@@ -81,9 +83,9 @@ class MainThreadTest(unittest.TestCase):
         def failing():
             raise ValueError("cannot save")
 
-        asker = Asker(failing)
+        asker = Asker(self.handover, failing)
         asker.start()
-        serve_until(lambda: asker.ended_at is not None)
+        serve_until(self.handover, lambda: asker.ended_at is not None)
         asker.join(5)
         self.assertIsInstance(asker.error, ValueError)
         self.assertEqual(str(asker.error), "cannot save")
@@ -91,14 +93,14 @@ class MainThreadTest(unittest.TestCase):
     def test_on_the_main_thread_the_work_is_done_at_once(self):
         # A blocking render from a script runs its handlers on the main thread: waiting for
         # the timer there would wait for itself.
-        self.assertEqual(main_thread.call(lambda: threading.current_thread()),
+        self.assertEqual(self.handover.call(lambda: threading.current_thread()),
                          threading.main_thread())
-        self.assertFalse(main_thread.pending())
+        self.assertFalse(self.handover.pending())
 
     def test_a_silent_main_thread_abandons_the_work_which_then_never_runs(self):
         main_thread.STALL_LIMIT = 0.3
         ran = []
-        asker = Asker(lambda: ran.append(1))
+        asker = Asker(self.handover, lambda: ran.append(1))
         start = time.monotonic()
         asker.start()
         asker.join(5)
@@ -106,39 +108,39 @@ class MainThreadTest(unittest.TestCase):
         self.assertIn("did not answer", str(asker.error))
         self.assertGreaterEqual(asker.ended_at - start, 0.3)
         self.assertLess(asker.ended_at - start, 2.0)
-        main_thread.serve()  # late: the frame it was for is gone
+        self.handover.serve()  # late: the frame it was for is gone
         self.assertEqual(ran, [])
-        self.assertFalse(main_thread.pending())
+        self.assertFalse(self.handover.pending())
 
     def test_work_being_done_is_waited_for_past_the_stall_limit(self):
         main_thread.STALL_LIMIT = 0.2
-        asker = Asker(time.sleep, 0.6)  # longer than the limit, but taken at once
+        asker = Asker(self.handover, time.sleep, 0.6)  # longer than the limit, but taken at once
         asker.start()
-        serve_until(lambda: asker.ended_at is not None)
+        serve_until(self.handover, lambda: asker.ended_at is not None)
         asker.join(5)
         self.assertIsNone(asker.error)
 
     def test_stop_releases_a_waiting_asker_and_refuses_new_work(self):
         ran = []
-        asker = Asker(lambda: ran.append(1))
+        asker = Asker(self.handover, lambda: ran.append(1))
         asker.start()
         time.sleep(0.2)
-        main_thread.stop()  # the add-on disabled during the render
+        self.handover.stop()  # the add-on disabled during the render
         asker.join(5)
         self.assertFalse(asker.is_alive())
         self.assertIsInstance(asker.error, main_thread.Abandoned)
-        late = Asker(lambda: ran.append(2))
+        late = Asker(self.handover, lambda: ran.append(2))
         late.start()
         late.join(5)
         self.assertIsInstance(late.error, main_thread.Abandoned)
-        main_thread.serve()
+        self.handover.serve()
         self.assertEqual(ran, [])
 
     def test_many_askers_each_get_their_own_result(self):
-        askers = [Asker(lambda i=i: i * i) for i in range(50)]
+        askers = [Asker(self.handover, lambda i=i: i * i) for i in range(50)]
         for asker in askers:
             asker.start()
-        serve_until(lambda: all(a.ended_at is not None for a in askers))
+        serve_until(self.handover, lambda: all(a.ended_at is not None for a in askers))
         for i, asker in enumerate(askers):
             asker.join(5)
             self.assertEqual(asker.result, i * i)
