@@ -837,6 +837,25 @@ class AddonTest(unittest.TestCase):
             os.path.join(folder, "out_0001.exr"), os.path.join(folder, "passes", "0001.exr"))
         self.assertLess(float(ao.mean()), 0.97)
 
+    def test_disabling_the_addon_keeps_the_nodes_and_lets_blender_quit(self):
+        # Disabled with a file's nodes, the add-on leaves them as group nodes and Blender quits
+        # cleanly: the depsgraph's evaluated copy of an SSAO node, freed after the node type
+        # was unregistered, crashed Blender when it quit (3.4.1: every time).
+        self.folder("disable")
+        blend = self.blender.build_scene("disable/scene")
+        script = (
+            "import addon_utils, sys\n"
+            "import bpy\n"
+            "package = next(n for n in sys.modules if n.endswith('ssao_compositor'))\n"
+            "compat = sys.modules[package + '.compat']\n"
+            "addon_utils.disable(package)\n"
+            "tree = compat.compositor_tree(bpy.context.scene)\n"
+            "print('[nodes]', sorted(n.bl_idname for n in tree.nodes))\n")
+        log = self.blender.run(blend, "--python-exit-code", "1", "--python-expr", script)
+        nodes = next(line for line in log.splitlines() if line.startswith("[nodes]"))
+        self.assertIn("CompositorNodeGroup", nodes)
+        self.assertNotIn("CompositorNodeSSAO", nodes)
+
     def test_compute_ao_function_returns_numpy(self):
         folder = self.folder("script")
         blend = self.blender.build_scene("script/scene", "--output",
