@@ -53,6 +53,9 @@ import time
 
 import numpy as np
 
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
+from image_files import read_image  # noqa: E402
+
 DEFAULT_EXAMPLES = ["/usr/share/povray-3.7/scenes", "/usr/share/doc/povray/examples"]
 SKIP = 77
 W, H = 40, 30
@@ -105,43 +108,26 @@ def sample(scenes, count):
     return scenes[::len(scenes) // count][:count]
 
 
-def read_ppm(path):
-    """An 8-bit binary PPM (P6) as a height x width x 3 uint8 array."""
-    with open(path, "rb") as f:
-        data = f.read()
-    fields, pos = [], 0
-    while len(fields) < 4:
-        while data[pos:pos + 1].isspace():
-            pos += 1
-        if data[pos:pos + 1] == b"#":
-            pos = data.index(b"\n", pos) + 1
-            continue
-        end = pos
-        while not data[end:end + 1].isspace():
-            end += 1
-        fields.append(data[pos:end])
-        pos = end
-    pos += 1
-    if fields[0] != b"P6":
-        raise ValueError(f"{path}: not a binary PPM")
-    width, height, maxval = (int(v) for v in fields[1:])
-    dtype = np.uint8 if maxval < 256 else np.dtype(">u2")
-    pixels = np.frombuffer(data, dtype, width * height * 3, pos).reshape(height, width, 3)
-    return (pixels.astype(np.float64) * (255.0 / maxval)).round()
+def read_pixels(path):
+    """A render (8- or 16-bit PPM) as a height x width x 3 array of 0-255 levels."""
+    return (read_image(path)[1].astype(np.float64) * 255.0).round()
+
+
+def is_uniform(pixels):
+    """Whether no colour of the image varies by more than PIXEL_TOLERANCE: such an image cannot
+    tell views apart."""
+    return bool((pixels.max(axis=(0, 1)) - pixels.min(axis=(0, 1))).max() <= PIXEL_TOLERANCE)
 
 
 def uniform_image(path):
-    """Whether no colour of the image varies by more than PIXEL_TOLERANCE: such an image cannot
-    tell views apart."""
-    a = read_ppm(path)
-    return bool((a.max(axis=(0, 1)) - a.min(axis=(0, 1))).max() <= PIXEL_TOLERANCE)
+    return is_uniform(read_pixels(path))
 
 
 def compare(first, second):
     """(fraction of pixels differing by more than PIXEL_TOLERANCE, fraction differing at all,
     largest difference, whether the first image is uniform) of two renders."""
-    a, b = read_ppm(first), read_ppm(second)
-    uniform = uniform_image(first)
+    a, b = read_pixels(first), read_pixels(second)
+    uniform = is_uniform(a)
     if a.shape != b.shape:
         return 1.0, 1.0, 255.0, uniform
     diff = np.abs(a - b).max(axis=2)
@@ -334,8 +320,8 @@ class Corpus:
                 stdout = proc.stdout if proc is not None and proc.returncode == 0 else ""
                 block = camera_block(stdout, "the depth and normal passes")
             else:
-                block = next((camera_block(stdout, h) for h in BLOCK_HEADERS
-                              if camera_block(stdout, h)), None)
+                block = next(filter(None, (camera_block(stdout, h) for h in BLOCK_HEADERS)),
+                             None)
             summary = stdout.splitlines()[:2]
             result["camera"] = " ".join(s.strip() for s in summary)
             warnings = [line for line in proc.stderr.splitlines() if "warning" in line]
