@@ -471,18 +471,6 @@ def register():
         pass
 
 
-def _drop_evaluated_nodes():
-    """Every scene's evaluated copy (the depsgraph's) of its compositor tree brought up to date:
-    it still holds the SSAO nodes just made group nodes, and freeing one after the node type is
-    unregistered crashed Blender when it quit (3.4.1: every time after the add-on was disabled
-    with a file's nodes; 4.3.2: some of the time)."""
-    for scene in bpy.data.scenes:
-        for view_layer in scene.view_layers:
-            depsgraph = view_layer.depsgraph
-            if depsgraph is not None:
-                depsgraph.update()
-
-
 def unregister():
     # A render thread waiting for the timer goes on without its work.
     session.current.main_thread.stop()
@@ -494,7 +482,6 @@ def unregister():
     # still multiplies by its last AO.
     try:
         saved_form.to_group_nodes()
-        _drop_evaluated_nodes()
     except Exception as error:
         report(f"keeping the nodes as group nodes failed: {error}", error=True)
     for name, handler in _HANDLERS:

@@ -5,13 +5,19 @@ import bpy
 from . import compute, handlers, session
 
 
-def _on_export_dir_changed(preferences, context):
+def _to_session(preferences):
+    """The session keeps what the preferences say (the one place the add-on reads them)."""
     session.current.export_dir = bpy.path.abspath(preferences.export_dir)
+    session.current.use_helper_process = preferences.helper_process
+
+
+def _on_export_dir_changed(preferences, context):
+    _to_session(preferences)
     handlers.set_up_nodes()
 
 
 def _on_helper_process_changed(preferences, context):
-    session.current.use_helper_process = preferences.helper_process
+    _to_session(preferences)
 
 
 class SSAOPreferences(bpy.types.AddonPreferences):
@@ -49,8 +55,7 @@ def register():
     bpy.utils.register_class(SSAOPreferences)
     addon = bpy.context.preferences.addons.get(__package__)
     if addon is not None and addon.preferences is not None:
-        session.current.export_dir = bpy.path.abspath(addon.preferences.export_dir)
-        session.current.use_helper_process = addon.preferences.helper_process
+        _to_session(addon.preferences)
 
 
 def unregister():
