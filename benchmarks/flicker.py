@@ -241,13 +241,11 @@ def moving_text(m):
             "x for %d frames (`scripts/blender/benchmark_moving.py`), the same 1024-spp "
             "reference. Over the %d pixels whose reference AO changed by more than %.2f from the "
             "frame before (the box and its contact shadow moved), the default's RMSE is %.4f, "
-            "each frame alone %.4f: the difference is the trail the temporal filter leaves, "
-            "changes carried from earlier frames that its rejection threshold (0.1) and its "
-            "clamp to the range of the frame's own values around the pixel (+- 0.01) let "
-            "through; the largest difference between the two anywhere is %.4f. (Measured once: "
-            "without the clamp 0.0876; a rejection threshold of 0.05 instead, 0.0801, but a "
-            "quarter to a half of the flicker's gain lost: contact 0.0083, cavity 0.0185 in "
-            "occluded pixels.)"
+            "each frame alone %.4f; the largest difference between the two anywhere is %.4f. "
+            "Where the depths show that the scene itself moved (a surface where an earlier "
+            "frame saw empty space, or one gone from where an earlier frame saw it), no earlier "
+            "frame is carried within the AO's radius on screen, so the shadow of what moved "
+            "leaves no trail ([variants.md](variants.md), temporal filter)."
             % (m["scene"], m["object"], m["step"], FRAMES, m["pixels"], CHANGED_BY,
                m["rmse_default"], m["rmse_alone"], m["largest"]))
 

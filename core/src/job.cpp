@@ -546,6 +546,7 @@ void Job::run() {
   const int frame_number = v.get_int("frame");
   temporal_.begin(frame_number, frame_number >= 0 ? v.get_int("temporal_frames") : 1, camera,
                   in.camera_to_world, window);
+  temporal_.find_motion(frame, radius, tiles);
   progress.set_stage(0.95, 1.0);
   denoiser.horizontal_pass(visibility.data(), tiles, progress);
 

@@ -121,8 +121,9 @@ const std::vector<Param>& params() {
                 "in a sequence (frame >= 0), the AO averages this many frames: this one and the "
                 "frames numbered just before it that the same job computed, each carried to "
                 "this frame's pixels through its depth and camera_to_world; a pixel the earlier "
-                "frame did not see, or whose AO changed by more than 0.1 (something moved), "
-                "takes no part. Steadies the sampling pattern's crawl on camera moves (measured: "
+                "frame did not see, one within radius of where the depths show that something "
+                "moved, or one whose AO changed by more than 0.1 takes no part. Steadies the "
+                "sampling pattern's crawl on camera moves (measured: "
                 "docs/performance.md); 1: each frame alone"),
       int_param(kExecution, "frame", -1, -1, 2147483647, "",
                 "this frame's number in its sequence, for temporal_frames; a job's frames must "

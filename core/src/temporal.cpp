@@ -31,6 +31,23 @@ struct CarryArgs {
 constexpr float kCarryDepthAgreement = 0.005f, kCarryRejection = 0.1f;
 // How far a carried value may lie outside the range of the frame's own values around it.
 constexpr float kCarryMargin = 0.01f;
+
+// What the motion test reads (TemporalHistory::find_motion): this frame and an earlier one,
+// both of the window's size.
+struct MotionArgs {
+  CameraIntrinsics here, there;
+  float to_entry[12], from_entry[12];  // this view -> the earlier frame's view, and back
+  const float* there_depth;            // the earlier frame's planar depths
+  const float* there_nearest;          // its nearest depth around each 2 x 2 block (near_blocks)
+  const float* here_nearest;           // the same of this frame
+  int width, height, blocks_across;    // the frames' size; near_blocks' width
+  float u0, v;                         // the first pixel centre of the row and the row's centre
+};
+// A depth beyond every depth around where a point lands, by more than this fraction, is
+// something that moved: no camera move makes a surface appear in empty space.
+constexpr float kMotionDepth = 0.02f;
+// Rows handed to motion_row are padded with background to a multiple of this.
+constexpr int kMotionRowPad = int(HWY_MAX_BYTES / sizeof(float));
 }  // namespace ssao
 #endif
 
@@ -42,11 +59,13 @@ namespace hn = hwy::HWY_NAMESPACE;
 // Pixels i < count of a row (planar depths depth[i], background skipped; values own[i]): each
 // one's value in the earlier frame, that of the pixel the point lands in there, added to sum[i]
 // (and 1 to n[i]) where that pixel shows the same surface (depth within kCarryDepthAgreement)
-// and the value is within kCarryRejection of its own. The nearest pixel rather than a bilinear
-// mix of four: a quarter of the gathers, and on the kit's camera moves less flicker (contact,
-// occluded pixels: 0.0062 against 0.0074).
+// and the value is within kCarryRejection of its own, unless moved[i] says the scene moved
+// near the pixel (find_motion). The nearest pixel rather than a bilinear mix of four: a
+// quarter of the gathers, and on the kit's camera moves less flicker (contact, occluded
+// pixels: 0.0062 against 0.0074).
 HWY_NOINLINE void carry_row(const CarryArgs& a, const float* depth, const float* own,
-                            const float* low, const float* high, int count, float* sum, float* n) {
+                            const float* low, const float* high, const float* moved, int count,
+                            float* sum, float* n) {
   const hn::ScalableTag<float> df;
   const hn::RebindToSigned<decltype(df)> di;
   using VF = hn::Vec<decltype(df)>;
@@ -59,11 +78,11 @@ HWY_NOINLINE void carry_row(const CarryArgs& a, const float* depth, const float*
   const VF y_unit = hn::Set(df, (a.here.center_v - a.v) * a.here.scale_v);
   const LaneProjection<VF> there(a.there, a.width, a.height);
   const auto width = hn::Set(di, a.width);
-  alignas(64) float stage[6][16];
+  alignas(64) float stage[7][16];
   for (int i = 0; i < count; i += lanes) {
     const int here = std::min(lanes, count - i);
     const float *d_at = depth + i, *own_at = own + i, *sum_at = sum + i, *n_at = n + i;
-    const float *low_at = low + i, *high_at = high + i;
+    const float *low_at = low + i, *high_at = high + i, *moved_at = moved + i;
     if (here < lanes) {  // stage the last lanes, padded with background
       for (int k = 0; k < lanes; ++k) {
         stage[0][k] = k < here ? depth[i + k] : std::numeric_limits<float>::infinity();
@@ -72,9 +91,10 @@ HWY_NOINLINE void carry_row(const CarryArgs& a, const float* depth, const float*
         stage[3][k] = k < here ? n[i + k] : 0.0f;
         stage[4][k] = k < here ? low[i + k] : 0.0f;
         stage[5][k] = k < here ? high[i + k] : 0.0f;
+        stage[6][k] = k < here ? moved[i + k] : 0.0f;
       }
       d_at = stage[0], own_at = stage[1], sum_at = stage[2], n_at = stage[3];
-      low_at = stage[4], high_at = stage[5];
+      low_at = stage[4], high_at = stage[5], moved_at = stage[6];
     }
     const VF d = hn::LoadU(df, d_at);
     const auto geometry = hn::Lt(d, inf);
@@ -102,7 +122,8 @@ HWY_NOINLINE void carry_row(const CarryArgs& a, const float* depth, const float*
                                  hn::LoadU(df, low_at) - margin, hn::LoadU(df, high_at) + margin);
     const VF own_v = hn::LoadU(df, own_at);
     const auto close = hn::Le(hn::Abs(carried - own_v), hn::Set(df, kCarryRejection));
-    const auto takes = hn::And(hn::And(inside, same_surface), close);
+    const auto still = hn::Eq(hn::LoadU(df, moved_at), hn::Zero(df));
+    const auto takes = hn::And(hn::And(hn::And(inside, same_surface), close), still);
     const VF new_sum = hn::LoadU(df, sum_at) + hn::IfThenElseZero(takes, carried);
     const VF new_n = hn::LoadU(df, n_at) + hn::IfThenElseZero(takes, one);
     if (here < lanes) {
@@ -115,6 +136,82 @@ HWY_NOINLINE void carry_row(const CarryArgs& a, const float* depth, const float*
       hn::StoreU(new_n, df, n + i);
     }
   }
+}
+
+// Pixels (u0 + 2 i, v), i < count, of this frame (planar depths depth[i]; the row padded with
+// background to a multiple of kMotionRowPad): moved[i] = 1 where the earlier frame shows
+// something a camera move does not explain, else 0; returns how many are 1. Either the point lies
+// in front of everything the earlier frame saw around where it lands there (it appeared: an object
+// moved in), or the earlier frame saw a surface in front of it which this frame no longer shows
+// around where that surface lands here (it vanished: an object moved away and uncovered this
+// point). Both compare against the nearest depth around the pixel (of the 4 x 4 square around
+// its 2 x 2 block, which holds its 3 x 3 square), so a surface seen at a grazing angle or an
+// edge a pixel away is not taken for motion; an uncovering by the camera's move finds its
+// occluder still there.
+HWY_NOINLINE size_t motion_row(const MotionArgs& a, const float* depth, int count, float* moved) {
+  const hn::ScalableTag<float> df;
+  const hn::RebindToSigned<decltype(df)> di;
+  using VF = hn::Vec<decltype(df)>;
+  const int lanes = int(hn::Lanes(df));
+  const VF one = hn::Set(df, 1.0f), two = hn::Set(df, 2.0f);
+  const VF inf = hn::Set(df, std::numeric_limits<float>::infinity());
+  const VF beyond = hn::Set(df, 1.0f + kMotionDepth), before = hn::Set(df, 1.0f - kMotionDepth);
+  const VF per_depth = hn::Set(df, a.here.orthographic ? 0.0f : 1.0f);
+  const VF there_per_depth = hn::Set(df, a.there.orthographic ? 0.0f : 1.0f);
+  VF to[12], from[12];
+  for (int k = 0; k < 12; ++k) to[k] = hn::Set(df, a.to_entry[k]);
+  for (int k = 0; k < 12; ++k) from[k] = hn::Set(df, a.from_entry[k]);
+  const VF y_unit = hn::Set(df, (a.here.center_v - a.v) * a.here.scale_v);
+  const LaneProjection<VF> here(a.here, a.width, a.height);
+  const LaneProjection<VF> there(a.there, a.width, a.height);
+  const auto width = hn::Set(di, a.width), blocks_across = hn::Set(di, a.blocks_across);
+  const auto block = [&](auto x, auto y) {
+    return hn::ShiftRight<1>(y) * blocks_across + hn::ShiftRight<1>(x);
+  };
+  const auto affine = [](const VF* m, VF x, VF y, VF z, VF& ox, VF& oy, VF& oz) {
+    ox = hn::MulAdd(m[0], x, hn::MulAdd(m[1], y, hn::MulAdd(m[2], z, m[3])));
+    oy = hn::MulAdd(m[4], x, hn::MulAdd(m[5], y, hn::MulAdd(m[6], z, m[7])));
+    oz = hn::MulAdd(m[8], x, hn::MulAdd(m[9], y, hn::MulAdd(m[10], z, m[11])));
+  };
+  size_t total = 0;
+  for (int i = 0; i < count; i += lanes) {
+    const VF d = hn::LoadU(df, depth + i);
+    const auto geometry = hn::Lt(d, inf);
+    const VF safe = hn::IfThenElse(geometry, d, one);
+    const VF scale = hn::MulAdd(per_depth, safe, one - per_depth);
+    const VF u = hn::MulAdd(hn::Iota(df, 0.0f), two, hn::Set(df, a.u0 + 2.0f * float(i)));
+    const VF px = (u - hn::Set(df, a.here.center_u)) * hn::Set(df, a.here.scale_u) * scale;
+    VF qx, qy, qz;
+    affine(to, px, y_unit * scale, hn::Neg(safe), qx, qy, qz);
+    const VF z = hn::Neg(qz);
+    VF fx, fy;
+    const auto inside = hn::And(there(qx, qy, qz, fx, fy), geometry);
+    const auto x = hn::ConvertTo(di, hn::IfThenElseZero(inside, fx));
+    const auto y = hn::ConvertTo(di, hn::IfThenElseZero(inside, fy));
+    const auto appeared =
+        hn::And(inside, hn::Gt(hn::GatherIndex(df, a.there_nearest, block(x, y)), z * beyond));
+    // The surface the earlier frame saw in front of the point, back in this frame.
+    const VF seen = hn::GatherIndex(df, a.there_depth, y * width + x);
+    const auto hidden = hn::And(inside, hn::Lt(seen, z * before));
+    auto found = appeared;
+    if (!hn::AllFalse(df, hidden)) {  // rare but where the view was uncovered
+      const VF seen_safe = hn::IfThenElse(hidden, seen, one);
+      VF rx, ry;
+      there.pixel_ray(x, y, rx, ry);
+      const VF there_scale = hn::MulAdd(there_per_depth, seen_safe, one - there_per_depth);
+      VF hx, hy, hz;
+      affine(from, rx * there_scale, ry * there_scale, hn::Neg(seen_safe), hx, hy, hz);
+      VF gx, gy;
+      const auto back_inside = hn::And(here(hx, hy, hz, gx, gy), hidden);
+      const auto back_index = block(hn::ConvertTo(di, hn::IfThenElseZero(back_inside, gx)),
+                                    hn::ConvertTo(di, hn::IfThenElseZero(back_inside, gy)));
+      const VF nearest_here = hn::GatherIndex(df, a.here_nearest, back_index);
+      found = hn::Or(found, hn::And(back_inside, hn::Gt(nearest_here, hn::Neg(hz) * beyond)));
+    }
+    hn::StoreU(hn::IfThenElseZero(found, one), df, moved + i);
+    total += hn::CountTrue(df, found);
+  }
+  return total;
 }
 
 }  // namespace HWY_NAMESPACE
@@ -136,6 +233,12 @@ namespace {
 // The widest compiled carry_row this CPU runs, chosen on first use.
 decltype(&HWY_STATIC_DISPATCH(carry_row)) best_carry_row() {
   static const auto row = SSAO_BEST_TARGET(carry_row);
+  return row;
+}
+
+// The widest compiled motion_row this CPU runs.
+decltype(&HWY_STATIC_DISPATCH(motion_row)) best_motion_row() {
+  static const auto row = SSAO_BEST_TARGET(motion_row);
   return row;
 }
 
@@ -206,6 +309,52 @@ SSAO_VECTORIZE void column_range(const float* row_low, const float* row_high, si
   }
 }
 
+// For each 2 x 2 block i < blocks of a row of `count` depths, the nearest of the depths
+// 2 i - 1 .. 2 i + 2 (those in the row). The blocks whose four depths are all in the row take a
+// loop without branches, which the compiler vectorises.
+SSAO_VECTORIZE void nearest_in_blocks(const float* __restrict row, int count, int blocks,
+                                      float* __restrict out) {
+  const auto edge = [&](int i) {
+    float m = std::numeric_limits<float>::infinity();
+    for (int x = std::max(2 * i - 1, 0); x <= std::min(2 * i + 2, count - 1); ++x) {
+      m = std::min(m, row[x]);
+    }
+    out[i] = m;
+  };
+  const int last_inner = (count - 3) / 2;  // 2 i + 2 <= count - 1
+  edge(0);
+  for (int i = 1; i <= last_inner; ++i) {
+    const float a = row[2 * i - 1], b = row[2 * i], c = row[2 * i + 1], d = row[2 * i + 2];
+    const float ab = a < b ? a : b, cd = c < d ? c : d;
+    out[i] = ab < cd ? ab : cd;
+  }
+  for (int i = std::max(last_inner + 1, 1); i < blocks; ++i) edge(i);
+}
+
+// out[i] = 1 for every cell of a width x height grid within r cells (a square) of a cell
+// marked in `marks`, else 0: running counts along the rows, then along the columns.
+void dilate_marks(const std::vector<uint8_t>& marks, int width, int height, int r,
+                  std::vector<float>& out) {
+  std::vector<int> along(size_t(width) * height), prefix(size_t(std::max(width, height)) + 1);
+  const auto spread = [&](int n, const auto& read, const auto& write) {
+    prefix[0] = 0;
+    for (int k = 0; k < n; ++k) prefix[k + 1] = prefix[k] + (read(k) ? 1 : 0);
+    for (int k = 0; k < n; ++k)
+      write(k, prefix[std::min(k + r + 1, n)] > prefix[std::max(k - r, 0)]);
+  };
+  for (int y = 0; y < height; ++y) {
+    const size_t row = size_t(y) * width;
+    spread(
+        width, [&](int x) { return marks[row + x] != 0; },
+        [&](int x, bool hit) { along[row + x] = hit; });
+  }
+  for (int x = 0; x < width; ++x) {
+    spread(
+        height, [&](int y) { return along[size_t(y) * width + x] != 0; },
+        [&](int y, bool hit) { out[size_t(y) * width + x] = hit ? 1.0f : 0.0f; });
+  }
+}
+
 }  // namespace
 
 void TemporalHistory::begin(int frame, int frames, const CameraModel& camera,
@@ -237,11 +386,107 @@ void TemporalHistory::begin(int frame, int frames, const CameraModel& camera,
     } else if (current_.depth.capacity() < e.depth.capacity()) {
       current_.depth.swap(e.depth);
       current_.visibility.swap(e.visibility);
+      current_.nearest.swap(e.nearest);
     }
   }
   earlier_ = std::move(usable);
   current_.depth.resize(size_t(width) * size_t(height));
   current_.visibility.resize(size_t(width) * size_t(height));
+  current_.nearest.resize(size_t((width + 1) / 2) * size_t((height + 1) / 2));
+}
+
+void TemporalHistory::find_motion(const Frame& frame, float radius, TilePool& tiles) {
+  moved_.clear();
+  if (frames_ <= 1) return;
+  const int width = current_.width, height = current_.height;
+  const size_t stride = size_t(width);
+  Progress uncancellable(nullptr, nullptr);
+  // This frame's depths over the window, and its nearest depth around each 2 x 2 block: over
+  // the 4 x 4 square centred on it (rows 2 j - 1 .. 2 j + 2 of nearest_in_blocks's).
+  const int blocks_across = (width + 1) / 2, blocks_down = (height + 1) / 2;
+  tiles.for_each_row_band(
+      blocks_across, blocks_down, kTileHeight, uncancellable, [&](const Tile& band) {
+        const int y0 = std::max(2 * band.y0 - 1, 0), y1 = std::min(2 * band.y1 + 2, height);
+        ScratchVector<float> rows(size_t(y1 - y0) * size_t(blocks_across));
+        for (int y = y0; y < y1; ++y) {
+          const float* depth = frame.depth_plane() + frame.index(window_.x0, window_.y0 + y);
+          if (y >= 2 * band.y0 && y < std::min(2 * band.y1, height)) {
+            std::copy_n(depth, width, current_.depth.data() + size_t(y) * stride);
+          }
+          nearest_in_blocks(depth, width, blocks_across,
+                            rows.data() + size_t(y - y0) * blocks_across);
+        }
+        for (int j = band.y0; j < band.y1; ++j) {
+          const float* r[4];
+          for (int k = 0; k < 4; ++k) {
+            r[k] =
+                rows.data() + size_t(std::clamp(2 * j - 1 + k, 0, height - 1) - y0) * blocks_across;
+          }
+          float* out = current_.nearest.data() + size_t(j) * blocks_across;
+          for (int i = 0; i < blocks_across; ++i) {
+            out[i] = std::min(std::min(r[0][i], r[1][i]), std::min(r[2][i], r[3][i]));
+          }
+        }
+      });
+  if (earlier_.empty()) return;
+  std::vector<MotionArgs> entries;
+  const CameraIntrinsics here = current_.camera.intrinsics();
+  for (const Entry& e : earlier_) {
+    MotionArgs args{};
+    args.here = here, args.there = e.camera.intrinsics();
+    args.there_depth = e.depth.data();
+    args.there_nearest = e.nearest.data(), args.here_nearest = current_.nearest.data();
+    args.width = width, args.height = height, args.blocks_across = blocks_across;
+    args.u0 = 0.5f;
+    double from_entry[12];
+    if (!invert_affine(e.to_entry, from_entry)) continue;  // the inverse of an inverse
+    for (int k = 0; k < 12; ++k) {
+      args.to_entry[k] = float(e.to_entry[k]);
+      args.from_entry[k] = float(from_entry[k]);
+    }
+    entries.push_back(args);
+  }
+  // The test runs on one pixel of each 2 x 2 block: what it finds is widened by the radius
+  // below, several pixels.
+  const int padded = (blocks_across + kMotionRowPad - 1) / kMotionRowPad * kMotionRowPad;
+  std::vector<uint8_t> marks(size_t(blocks_across) * size_t(blocks_down), 0);
+  // Per band, the widest radius on screen of a point that moved, in pixels.
+  std::vector<float> reaches(size_t((blocks_down + kTileHeight - 1) / kTileHeight), 0.0f);
+  tiles.for_each_row_band(
+      blocks_across, blocks_down, kTileHeight, uncancellable, [&](const Tile& band) {
+        ScratchVector<float> depths(padded), found(padded);
+        std::vector<MotionArgs> band_entries = entries;  // each band sets its own row centre
+        float reach = 0.0f;
+        for (int j = band.y0; j < band.y1; ++j) {
+          const float* row = current_.depth.data() + size_t(2 * j) * stride;
+          for (int i = 0; i < padded; ++i) {
+            depths[i] = i < blocks_across ? row[2 * i] : std::numeric_limits<float>::infinity();
+          }
+          for (MotionArgs& args : band_entries) {
+            args.v = float(2 * j) + 0.5f;
+            if (best_motion_row()(args, depths.data(), blocks_across, found.data()) == 0) {
+              continue;
+            }
+            for (int i = 0; i < blocks_across; ++i) {
+              if (found[i] == 0.0f) continue;
+              marks[size_t(j) * blocks_across + i] = 1;
+              // Receivers up to a radius in front of the point see it: their radius on screen.
+              const float z = std::max(depths[i] - radius, 0.5f * depths[i]);
+              reach = std::max(
+                  reach, here.orthographic ? radius / here.scale_u : radius / (here.scale_u * z));
+            }
+          }
+        }
+        reaches[size_t(band.y0 / kTileHeight)] = reach;
+      });
+  const float reach = *std::max_element(reaches.begin(), reaches.end());
+  if (reach == 0.0f) return;
+  // Every block within that reach of a mark (a square).
+  const int r =
+      int(std::min(std::ceil(reach / 2.0f) + 1.0f, float(std::max(blocks_across, blocks_down))));
+  moved_width_ = blocks_across;
+  moved_.assign(size_t(blocks_across) * size_t(blocks_down), 0.0f);
+  dilate_marks(marks, blocks_across, blocks_down, r, moved_);
 }
 
 void TemporalHistory::blend(const Frame& frame, const Tile& t, float* values) {
@@ -250,9 +495,9 @@ void TemporalHistory::blend(const Frame& frame, const Tile& t, float* values) {
   const auto at = [&](int y) {  // row y's place in this frame's record
     return size_t(y - window_.y0) * size_t(current_.width) + size_t(t.x0 - window_.x0);
   };
-  // This frame's values before averaging, for the frames after it.
+  // This frame's values before averaging, for the frames after it (find_motion recorded its
+  // depths).
   for (int y = t.y0; y < t.y1; ++y) {
-    std::copy_n(frame.depth_plane() + frame.index(t.x0, y), width, current_.depth.data() + at(y));
     std::copy_n(values + size_t(y - t.y0) * width, width, current_.visibility.data() + at(y));
   }
   if (earlier_.empty()) return;
@@ -263,7 +508,7 @@ void TemporalHistory::blend(const Frame& frame, const Tile& t, float* values) {
     row_range(current_.visibility.data() + at(y), width, row_low.data() + size_t(y - t.y0) * width,
               row_high.data() + size_t(y - t.y0) * width);
   }
-  ScratchVector<float> sum(width), count(width), low(width), high(width);
+  ScratchVector<float> sum(width), count(width), low(width), high(width), moved(width);
   for (int y = t.y0; y < t.y1; ++y) {
     const float* depth = frame.depth_plane() + frame.index(t.x0, y);
     float* row = values + size_t(y - t.y0) * width;
@@ -272,6 +517,13 @@ void TemporalHistory::blend(const Frame& frame, const Tile& t, float* values) {
                  low.data(), high.data());
     std::copy_n(row, width, sum.data());
     std::fill_n(count.data(), width, 1.0f);
+    // Whether the scene moved near each pixel (find_motion's half grid).
+    if (moved_.empty()) {
+      std::fill_n(moved.data(), width, 0.0f);
+    } else {
+      const float* cells = moved_.data() + size_t((y - window_.y0) / 2) * size_t(moved_width_);
+      for (int i = 0; i < width; ++i) moved[i] = cells[(t.x0 - window_.x0 + i) / 2];
+    }
     const float u0 = float(t.x0 - window_.x0) + 0.5f, v = float(y - window_.y0) + 0.5f;
     for (const Entry& e : earlier_) {
       CarryArgs args{current_.camera.intrinsics(),
@@ -284,7 +536,8 @@ void TemporalHistory::blend(const Frame& frame, const Tile& t, float* values) {
                      u0,
                      v};
       for (int k = 0; k < 12; ++k) args.to_entry[k] = float(e.to_entry[k]);
-      best_carry_row()(args, depth, row, low.data(), high.data(), width, sum.data(), count.data());
+      best_carry_row()(args, depth, row, low.data(), high.data(), moved.data(), width, sum.data(),
+                       count.data());
     }
     for (int i = 0; i < width; ++i) row[i] = sum[i] / count[i];
   }
