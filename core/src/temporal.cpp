@@ -139,11 +139,12 @@ HWY_NOINLINE void carry_row(const CarryArgs& a, const float* depth, const float*
 }
 
 // Pixels (u0 + 2 i, v), i < count, of this frame (planar depths depth[i]; the row padded with
-// background to a multiple of kMotionRowPad): moved[i] = 1 where the earlier frame shows
-// something a camera move does not explain, else 0; returns how many are 1. Either the point lies
-// in front of everything the earlier frame saw around where it lands there (it appeared: an object
-// moved in), or the earlier frame saw a surface in front of it which this frame no longer shows
-// around where that surface lands here (it vanished: an object moved away and uncovered this
+// background to a multiple of kMotionRowPad): moved[i] > 0 where the earlier frame shows
+// something a camera move does not explain, else 0; returns how many are > 0. moved[i] is the
+// depth here of what moved: the point, or the surface that left from in front of it. Either the
+// point lies in front of everything the earlier frame saw around where it lands there (it appeared:
+// an object moved in), or the earlier frame saw a surface in front of it which this frame no longer
+// shows around where that surface lands here (it vanished: an object moved away and uncovered this
 // point). Both compare against the nearest depth around the pixel (of the 4 x 4 square around
 // its 2 x 2 block, which holds its 3 x 3 square), so a surface seen at a grazing angle or an
 // edge a pixel away is not taken for motion; an uncovering by the camera's move finds its
@@ -194,6 +195,7 @@ HWY_NOINLINE size_t motion_row(const MotionArgs& a, const float* depth, int coun
     const VF seen = hn::GatherIndex(df, a.there_depth, y * width + x);
     const auto hidden = hn::And(inside, hn::Lt(seen, z * before));
     auto found = appeared;
+    VF nearest_moved = safe;          // the point, or what moved away from in front of it if nearer
     if (!hn::AllFalse(df, hidden)) {  // rare but where the view was uncovered
       const VF seen_safe = hn::IfThenElse(hidden, seen, one);
       VF rx, ry;
@@ -206,9 +208,11 @@ HWY_NOINLINE size_t motion_row(const MotionArgs& a, const float* depth, int coun
       const auto back_index = block(hn::ConvertTo(di, hn::IfThenElseZero(back_inside, gx)),
                                     hn::ConvertTo(di, hn::IfThenElseZero(back_inside, gy)));
       const VF nearest_here = hn::GatherIndex(df, a.here_nearest, back_index);
-      found = hn::Or(found, hn::And(back_inside, hn::Gt(nearest_here, hn::Neg(hz) * beyond)));
+      const auto vanished = hn::And(back_inside, hn::Gt(nearest_here, hn::Neg(hz) * beyond));
+      found = hn::Or(found, vanished);
+      nearest_moved = hn::IfThenElse(vanished, hn::Min(safe, hn::Neg(hz)), safe);
     }
-    hn::StoreU(hn::IfThenElseZero(found, one), df, moved + i);
+    hn::StoreU(hn::IfThenElseZero(found, nearest_moved), df, moved + i);
     total += hn::CountTrue(df, found);
   }
   return total;
@@ -470,8 +474,9 @@ void TemporalHistory::find_motion(const Frame& frame, float radius, TilePool& ti
             for (int i = 0; i < blocks_across; ++i) {
               if (found[i] == 0.0f) continue;
               marks[size_t(j) * blocks_across + i] = 1;
-              // Receivers up to a radius in front of the point see it: their radius on screen.
-              const float z = std::max(depths[i] - radius, 0.5f * depths[i]);
+              // Receivers up to a radius in front of what moved see it: their radius on
+              // screen.
+              const float z = std::max(found[i] - radius, 0.5f * found[i]);
               reach = std::max(
                   reach, here.orthographic ? radius / here.scale_u : radius / (here.scale_u * z));
             }
