@@ -46,8 +46,9 @@ struct MotionArgs {
 // A depth beyond every depth around where a point lands, by more than this fraction, is
 // something that moved: no camera move makes a surface appear in empty space.
 constexpr float kMotionDepth = 0.02f;
-// Rows handed to motion_row are padded with background to a multiple of this.
-constexpr int kMotionRowPad = int(HWY_MAX_BYTES / sizeof(float));
+// Rows handed to motion_row are padded with background to a multiple of this: the most lanes
+// of any x86 target (AVX-512), checked in each target's kernel.
+constexpr int kMotionRowPad = 16;
 }  // namespace ssao
 #endif
 
@@ -150,6 +151,7 @@ HWY_NOINLINE void carry_row(const CarryArgs& a, const float* depth, const float*
 // edge a pixel away is not taken for motion; an uncovering by the camera's move finds its
 // occluder still there.
 HWY_NOINLINE size_t motion_row(const MotionArgs& a, const float* depth, int count, float* moved) {
+  static_assert(HWY_LANES(float) <= kMotionRowPad, "the rows' padding is a whole vector");
   const hn::ScalableTag<float> df;
   const hn::RebindToSigned<decltype(df)> di;
   using VF = hn::Vec<decltype(df)>;
