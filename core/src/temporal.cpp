@@ -38,9 +38,9 @@ struct MotionArgs {
   CameraIntrinsics here, there;
   float to_entry[12], from_entry[12];  // this view -> the earlier frame's view, and back
   const float* there_depth;            // the earlier frame's planar depths
-  const float* there_nearest;          // its nearest depth around each 2 x 2 block (near_blocks)
+  const float* there_nearest;          // its nearest depth around each 2 x 2 block (Entry)
   const float* here_nearest;           // the same of this frame
-  int width, height, blocks_across;    // the frames' size; near_blocks' width
+  int width, height, blocks_across;    // the frames' size; blocks in a row of those
   float u0, v;                         // the first pixel centre of the row and the row's centre
 };
 // A depth beyond every depth around where a point lands, by more than this fraction, is

@@ -52,7 +52,7 @@ class TemporalHistory {
     CameraModel camera{CameraParams{}, 1, 1};  // of the window's pixels
     double camera_to_world[16] = {};
     std::vector<float> depth, visibility;  // the window's, row-major
-    std::vector<float> nearest;            // the nearest depth of each 3 x 3 square
+    std::vector<float> nearest;  // per 2 x 2 block, the nearest depth of the 4 x 4 around it
     // From this run's view space to the entry's (set by begin for the earlier frames).
     double to_entry[12] = {};
   };
@@ -60,7 +60,7 @@ class TemporalHistory {
   std::deque<Entry> earlier_;
   Entry current_;
   Tile window_{0, 0, 0, 0};
-  // 1 where the scene moved near the pixel, on a grid of every other pixel and row (empty: it
+  // 1 where the scene moved near the pixel, per 2 x 2 block of the window (empty: it
   // moved nowhere).
   std::vector<float> moved_;
   int moved_width_ = 0;
