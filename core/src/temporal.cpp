@@ -57,6 +57,14 @@ namespace ssao {
 namespace HWY_NAMESPACE {
 namespace hn = hwy::HWY_NAMESPACE;
 
+// (ox, oy, oz) = m (x, y, z, 1) for m the top 3 rows of an affine map, broadcast on lanes.
+template <class VF>
+HWY_INLINE void transform_affine(const VF* m, VF x, VF y, VF z, VF& ox, VF& oy, VF& oz) {
+  ox = hn::MulAdd(m[0], x, hn::MulAdd(m[1], y, hn::MulAdd(m[2], z, m[3])));
+  oy = hn::MulAdd(m[4], x, hn::MulAdd(m[5], y, hn::MulAdd(m[6], z, m[7])));
+  oz = hn::MulAdd(m[8], x, hn::MulAdd(m[9], y, hn::MulAdd(m[10], z, m[11])));
+}
+
 // Pixels i < count of a row (planar depths depth[i], background skipped; values own[i]): each
 // one's value in the earlier frame, that of the pixel the point lands in there, added to sum[i]
 // (and 1 to n[i]) where that pixel shows the same surface (depth within kCarryDepthAgreement)
@@ -104,9 +112,8 @@ HWY_NOINLINE void carry_row(const CarryArgs& a, const float* depth, const float*
     const VF u = hn::Iota(df, a.u0 + float(i));
     const VF px = (u - hn::Set(df, a.here.center_u)) * hn::Set(df, a.here.scale_u) * scale;
     const VF py = y_unit * scale, pz = hn::Neg(safe);
-    const VF qx = hn::MulAdd(m[0], px, hn::MulAdd(m[1], py, hn::MulAdd(m[2], pz, m[3])));
-    const VF qy = hn::MulAdd(m[4], px, hn::MulAdd(m[5], py, hn::MulAdd(m[6], pz, m[7])));
-    const VF qz = hn::MulAdd(m[8], px, hn::MulAdd(m[9], py, hn::MulAdd(m[10], pz, m[11])));
+    VF qx, qy, qz;
+    transform_affine(m, px, py, pz, qx, qy, qz);
     const VF z = hn::Neg(qz);  // planar depth there
     // The point's continuous image coordinates in the earlier frame, and the pixel there.
     VF fx, fy;
@@ -171,11 +178,6 @@ HWY_NOINLINE size_t motion_row(const MotionArgs& a, const float* depth, int coun
   const auto block = [&](auto x, auto y) {
     return hn::ShiftRight<1>(y) * blocks_across + hn::ShiftRight<1>(x);
   };
-  const auto affine = [](const VF* m, VF x, VF y, VF z, VF& ox, VF& oy, VF& oz) {
-    ox = hn::MulAdd(m[0], x, hn::MulAdd(m[1], y, hn::MulAdd(m[2], z, m[3])));
-    oy = hn::MulAdd(m[4], x, hn::MulAdd(m[5], y, hn::MulAdd(m[6], z, m[7])));
-    oz = hn::MulAdd(m[8], x, hn::MulAdd(m[9], y, hn::MulAdd(m[10], z, m[11])));
-  };
   size_t total = 0;
   for (int i = 0; i < count; i += lanes) {
     const VF d = hn::LoadU(df, depth + i);
@@ -185,7 +187,7 @@ HWY_NOINLINE size_t motion_row(const MotionArgs& a, const float* depth, int coun
     const VF u = hn::MulAdd(hn::Iota(df, 0.0f), two, hn::Set(df, a.u0 + 2.0f * float(i)));
     const VF px = (u - hn::Set(df, a.here.center_u)) * hn::Set(df, a.here.scale_u) * scale;
     VF qx, qy, qz;
-    affine(to, px, y_unit * scale, hn::Neg(safe), qx, qy, qz);
+    transform_affine(to, px, y_unit * scale, hn::Neg(safe), qx, qy, qz);
     const VF z = hn::Neg(qz);
     VF fx, fy;
     const auto inside = hn::And(there(qx, qy, qz, fx, fy), geometry);
@@ -204,7 +206,7 @@ HWY_NOINLINE size_t motion_row(const MotionArgs& a, const float* depth, int coun
       there.pixel_ray(x, y, rx, ry);
       const VF there_scale = hn::MulAdd(there_per_depth, seen_safe, one - there_per_depth);
       VF hx, hy, hz;
-      affine(from, rx * there_scale, ry * there_scale, hn::Neg(seen_safe), hx, hy, hz);
+      transform_affine(from, rx * there_scale, ry * there_scale, hn::Neg(seen_safe), hx, hy, hz);
       VF gx, gy;
       const auto back_inside = hn::And(here(hx, hy, hz, gx, gy), hidden);
       const auto back_index = block(hn::ConvertTo(di, hn::IfThenElseZero(back_inside, gx)),
