@@ -330,6 +330,92 @@ class OtherInputs(unittest.TestCase):
         self.assertIn("horizon", {v["name"] for v in ssao.variants()})
 
 
+class SequenceOfFrames(unittest.TestCase):
+    """ssao.Sequence: a shot's frames in one job, whose temporal filter averages each frame
+    with those before it: the bits of the CLI's --frames run of the same shot."""
+
+    @classmethod
+    def setUpClass(cls):
+        cls.depth, cls.normals, cls.beauty, camera = load_sample()
+        # The camera trucks 2 cm a frame along the world's x: the pattern lands elsewhere.
+        cls.cameras = []
+        for k in range(3):
+            moved = json.loads(json.dumps(camera))
+            moved["matrix_world"][0][3] += 0.02 * k
+            cls.cameras.append(moved)
+
+    def cli_sequence(self, *args):
+        """The CLI's AO of frames 1-3: the sample's passes with the moving cameras."""
+        with tempfile.TemporaryDirectory() as folder:
+            for k, camera in enumerate(self.cameras, start=1):
+                os.symlink(os.path.abspath(SAMPLE + ".exr"),
+                           os.path.join(folder, f"shot.{k:04d}.exr"))
+                with open(os.path.join(folder, f"camera.{k:04d}.json"), "w") as f:
+                    json.dump(camera, f)
+            subprocess.run([CLI, os.path.join(folder, "shot.####.exr"), "--frames", "1-3",
+                            "--camera", os.path.join(folder, "camera.####.json"),
+                            "-o", os.path.join(folder, "ao.####.exr"), "--radius", "0.8",
+                            "--ao-only", "--quiet", *args], check=True,
+                           stderr=subprocess.DEVNULL)
+            return [read_image(os.path.join(folder, f"ao.{k:04d}.exr"))[1][:, :, 0]
+                    for k in (1, 2, 3)]
+
+    def sequence(self, first_frame=1, **parameters):
+        with ssao.Sequence() as shot:
+            return [shot.ambient_occlusion(self.depth, normals=self.normals, camera=camera,
+                                           radius=0.8, frame=first_frame + k, **parameters)
+                    for k, camera in enumerate(self.cameras)]
+
+    def test_frames_are_the_cli_sequence(self):
+        cli = self.cli_sequence()
+        alone = [ssao.ambient_occlusion(self.depth, normals=self.normals, camera=camera,
+                                        radius=0.8) for camera in self.cameras]
+        for first_frame in (1, -1):  # Blender's frames may be negative
+            aos = self.sequence(first_frame)
+            for k in range(3):
+                AgainstCli.assert_same_bits(self, aos[k], cli[k])
+        AgainstCli.assert_same_bits(self, aos[0], alone[0])  # nothing before it
+        for k in (1, 2):  # the filter acts
+            self.assertGreater(np.count_nonzero(np.abs(aos[k] - alone[k]) > 1e-3), 1000)
+
+    def test_one_temporal_frame_is_each_frame_alone(self):
+        cli = self.cli_sequence("--temporal-frames", "1")
+        for k, ao in enumerate(self.sequence(temporal_frames=1)):
+            AgainstCli.assert_same_bits(self, ao, cli[k])
+            AgainstCli.assert_same_bits(self, ao, ssao.ambient_occlusion(
+                self.depth, normals=self.normals, camera=self.cameras[k], radius=0.8))
+
+    def test_a_frame_again_uses_only_the_frames_before_it(self):
+        with ssao.Sequence() as shot:
+            run = [shot.ambient_occlusion(self.depth, normals=self.normals, camera=camera,
+                                          radius=0.8, frame=k + 1)
+                   for k, camera in enumerate(self.cameras)]
+            again = shot.ambient_occlusion(self.depth, normals=self.normals,
+                                           camera=self.cameras[2], radius=0.8, frame=3)
+            AgainstCli.assert_same_bits(self, again, run[2])
+            first = shot.ambient_occlusion(self.depth, normals=self.normals,
+                                           camera=self.cameras[0], radius=0.8, frame=1)
+            AgainstCli.assert_same_bits(self, first, run[0])
+
+    def test_bad_frames_and_inputs(self):
+        with ssao.Sequence() as shot:
+            for frame in (True, 1.0, "1", 2 ** 30, -2 ** 30, None):
+                with self.assertRaisesRegex(ssao.SSAOError, "frame must be an int"):
+                    shot.ambient_occlusion(self.depth, camera=self.cameras[0], frame=frame)
+            with self.assertRaisesRegex(ssao.SSAOError, "normals has shape"):
+                shot.ambient_occlusion(self.depth, normals=self.normals[:10],
+                                       camera=self.cameras[0], frame=1)
+            # A frame's images and output window are not the next frame's: frame 1 again
+            # (nothing before it) without normals and window is frame 1 alone without them.
+            height, width = self.depth.shape
+            shot.ambient_occlusion(self.depth, normals=self.normals, camera=self.cameras[0],
+                                   radius=0.8, frame=1,
+                                   output_window=(4, 4, width - 8, height - 8))
+            ao = shot.ambient_occlusion(self.depth, camera=self.cameras[0], radius=0.8, frame=1)
+            AgainstCli.assert_same_bits(self, ao, ssao.ambient_occlusion(
+                self.depth, camera=self.cameras[0], radius=0.8))
+
+
 class BadInput(unittest.TestCase):
     """Every bad input is an ssao.SSAOError with a message that says what is wrong."""
 

@@ -20,9 +20,9 @@ from ._binding import (PARAM_FLOAT, PARAM_FLOATS, PARAM_INT, PARAM_STRING, Job, 
                        image_layout_error, library, load_library)
 from . import _binding
 
-__all__ = ["ambient_occlusion", "read_camera", "camera_parameters", "parameters", "variants",
-           "version", "library", "load_library", "Job", "SSAOError", "image_layout_error",
-           "PARAM_INT", "PARAM_FLOAT", "PARAM_STRING", "PARAM_FLOATS"]
+__all__ = ["ambient_occlusion", "Sequence", "read_camera", "camera_parameters", "parameters",
+           "variants", "version", "library", "load_library", "Job", "SSAOError",
+           "image_layout_error", "PARAM_INT", "PARAM_FLOAT", "PARAM_STRING", "PARAM_FLOATS"]
 _NO_GEOMETRY = ("the depth has no geometry pixel (every value is NaN, infinite, <= 0, or at "
                 "least background_depth or clip_end): is it the depth pass?")
 
@@ -167,6 +167,18 @@ def ambient_occlusion(depth, *, normals=None, camera, depth_layers=(), facing_la
     Raises SSAOError (bad input, a library error with its message, a depth without any
     geometry pixel) and never returns a partial image.
     """
+    return _ambient_occlusion(
+        None, depth, normals=normals, camera=camera, depth_layers=depth_layers,
+        facing_layers=facing_layers, beauty=beauty, ambient=ambient,
+        output_window=output_window, progress=progress, require_geometry=require_geometry,
+        run_stats=run_stats, **parameters)
+
+
+def _ambient_occlusion(job, depth, *, normals=None, camera, depth_layers=(), facing_layers=(),
+                       beauty=None, ambient=None, output_window=None, progress=None,
+                       require_geometry=True, run_stats=None, **parameters):
+    """ambient_occlusion() in `job` (a Sequence's: its images are detached after the run), or
+    in a job of its own (None)."""
     import numpy as np
     depth_layers, facing_layers = list(depth_layers), list(facing_layers)  # iterated twice
     _check_image("depth", depth, None, channels=(1,))
@@ -193,9 +205,11 @@ def ambient_occlusion(depth, *, normals=None, camera, depth_layers=(), facing_la
         camera = read_camera(camera)
     ao = np.empty(frame, np.float32)
     composite = np.empty(beauty.shape, np.float32) if beauty is not None else None
-    with Job(library()) as job:
+    own_job = Job(library()) if job is None else None
+    job = job or own_job
+    try:
         if camera is not None:
-            _apply_camera(job, camera, stacklevel=2)
+            _apply_camera(job, camera, stacklevel=3)
         _set_all(job, parameters, "")  # after the camera: an argument overrides the file
         job.set_image("depth", depth)
         if normals is not None:
@@ -206,6 +220,8 @@ def ambient_occlusion(depth, *, normals=None, camera, depth_layers=(), facing_la
             job.set_image(f"facing{k + 2}", layer)
         if output_window is not None:
             job.set_output_window(x, y)
+        elif own_job is None:  # a window of the sequence's frame before
+            job.set_output_window(0, 0, enable=False)
         job.set_image("ao", ao)
         if beauty is not None:
             job.set_image("beauty", beauty)
@@ -225,7 +241,49 @@ def ambient_occlusion(depth, *, normals=None, camera, depth_layers=(), facing_la
             run_stats.update(geometry_pixels=geometry_pixels, mean_ao=mean_ao)
         if geometry_pixels == 0 and require_geometry:
             raise SSAOError(_NO_GEOMETRY)
+    finally:
+        if own_job is not None:
+            own_job.close()
+        else:
+            job.detach_images()  # the caller's arrays are not the job's beyond the call
     return (ao, composite) if beauty is not None else ao
+
+
+class Sequence:
+    """The frames of a shot computed in one library job, so that the temporal filter
+    (`temporal_frames`, default 3) averages each frame with the frames numbered just before it
+    that this sequence computed, each carried to its pixels through depth and both cameras
+    (docs/variants.md, "Temporal filter"): the sampling pattern then does not crawl over the
+    surfaces as the camera moves. Each frame's camera needs its matrix_world (without one the
+    camera counts as still). Give the frames in increasing order: a frame at or before one
+    computed averages only the frames before it. Parameters keep their values from one frame to
+    the next until given again (a library job's rule), so a radius chosen automatically on the
+    first frame stays. Use as a context manager or call close()."""
+
+    # The library numbers a sequence's frames from 0; a shot's may be negative (Blender's).
+    _FRAME_ORIGIN = 2 ** 30
+
+    def __init__(self, lib=None):
+        self._job = Job(lib or library())
+
+    def close(self):
+        self._job.close()
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.close()
+
+    def ambient_occlusion(self, depth, *, frame, **arguments):
+        """ssao.ambient_occlusion(depth, **arguments) as frame number `frame` of the shot (an
+        int, |frame| < 2**30). Raises as ambient_occlusion does; a frame that failed takes no
+        part in the frames after it."""
+        if not isinstance(frame, numbers.Integral) or isinstance(frame, bool) or \
+                abs(int(frame)) >= self._FRAME_ORIGIN:
+            raise SSAOError(f"frame must be an int of magnitude below 2**30, got {frame!r}")
+        self._job.set("frame", int(frame) + self._FRAME_ORIGIN)
+        return _ambient_occlusion(self._job, depth, **arguments)
 
 
 def _window(output_window, shape):

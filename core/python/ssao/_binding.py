@@ -422,6 +422,11 @@ class Job:
                                      channels, pixel_stride, row_stride)
         self._images[name] = array
 
+    def detach_images(self):
+        """Detaches every image attached with set_image (the job keeps its parameters)."""
+        for name in list(self._images):
+            self.set_image(name, None)
+
     def set_output_window(self, x, y, enable=True):
         """Overscan: the outputs are the window at (x, y) of the depth image (ssao.h)."""
         self._lib.ssao_job_set_output_window(self._job, int(bool(enable)),
