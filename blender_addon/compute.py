@@ -29,6 +29,9 @@ EEVEE_BACKGROUND_DEPTH = 65504.0
 # The library's parameter groups (ssao_param_group) the node shows: every parameter that
 # changes the look. The input, camera and execution groups the add-on sets itself.
 NODE_GROUPS = ("ao", "quality", "shaping")
+# And, of the execution group, the temporal filter's length: how many frames of an animation
+# render the AO averages (Sequences below; 1: each frame alone).
+NODE_EXECUTION_PARAMETERS = ("temporal_frames",)
 
 
 @functools.lru_cache(maxsize=1)
@@ -36,14 +39,16 @@ def library_table():
     """libssao's parameter and variant tables as the add-on uses them, read once (raises when
     the library cannot be loaded; a later call tries again):
       parameters: {name: description (ssao.parameters)}, in the library's order;
-      node_parameter_names: the names the node shows (NODE_GROUPS), in that order;
+      node_parameter_names: the names the node shows (NODE_GROUPS and
+        NODE_EXECUTION_PARAMETERS), in the library's order;
       variant_parameters: {variant: the names only that variant reads}."""
     lib = library()
     parameters = {p["name"]: p for p in ssao.parameters(lib)}
     return types.SimpleNamespace(
         parameters=parameters,
         node_parameter_names=tuple(name for name, p in parameters.items()
-                                   if p["group"] in NODE_GROUPS),
+                                   if p["group"] in NODE_GROUPS or
+                                   name in NODE_EXECUTION_PARAMETERS),
         variant_parameters={v["name"]: set(v["parameters"]) for v in ssao.variants(lib)})
 
 
@@ -302,14 +307,44 @@ def threads(scene):
     return render.threads if render.threads_mode == 'FIXED' else 0
 
 
-def compute_node(node, scene, passes, wait=True, run_stats=None):
+class Sequences:
+    """The frames of one animation render, computed in frame order (handlers.py: headless from
+    render_init to render_complete; in the UI the frames written, after the job): an
+    ssao.Sequence per SSAO node, in which the library's temporal filter (the node's
+    temporal_frames) averages each frame with the frames before it, carried through depth and
+    camera. A frame seen through another camera object than the one before (a cut by camera
+    markers) starts the node's sequence again."""
+
+    def __init__(self):
+        self._shots = {}  # (scene name, node name) -> (camera name, ssao.Sequence)
+
+    def shot(self, scene, node):
+        """The ssao.Sequence of `node` for the scene's frame."""
+        key = (scene.name, node.name)
+        camera = scene.camera.name if scene.camera is not None else ""
+        kept = self._shots.get(key)
+        if kept is None or kept[0] != camera:
+            if kept is not None:
+                kept[1].close()
+            kept = self._shots[key] = (camera, ssao.Sequence(library()))
+        return kept[1]
+
+    def close(self):
+        for _, shot in self._shots.values():
+            shot.close()
+        self._shots.clear()
+
+
+def compute_node(node, scene, passes, wait=True, run_stats=None, sequences=None):
     """AO of `node` from exported `passes` (read_export's: normal xyz, depth[, the Image's
     alpha]); fills the node's AO image (with the composite's factor: inner_tree.py) and returns
     the AO with row 0 on top. Raises, leaving the AO image as it was, when the inputs, the
     parameters or the library cannot give this frame's AO. With wait=False (the UI) a helper
     render the node needs is asked of helper_process and, until its layers come, the AO is
     computed without them (waiting_status()). run_stats (a dict, optional) gets what the
-    library saw: "geometry_pixels" and their "mean_ao" (ssao.ambient_occlusion's)."""
+    library saw: "geometry_pixels" and their "mean_ao" (ssao.ambient_occlusion's). With
+    `sequences` (an animation render's Sequences) the scene's current frame is the next frame
+    of the node's sequence; without, it is computed alone."""
     use_normals = check_inputs(node)
     check_parameters(node)
     library()  # before the helper render (library_inputs): a missing library renders none
@@ -324,8 +359,10 @@ def compute_node(node, scene, passes, wait=True, run_stats=None):
     images, overscan = library_inputs(node, scene, passes, use_normals, wait)
     height, width = beauty.shape[:2]
     layers = range(2, 2 + sum(name.startswith("facing") for name in images))  # depth2, ...
+    run = ssao.ambient_occlusion if sequences is None else functools.partial(
+        sequences.shot(scene, node).ambient_occlusion, frame=scene.frame_current)
     # A frame without geometry (only sky) is AO 1, not an error: an animation goes on.
-    ao, composite = ssao.ambient_occlusion(
+    ao, composite = run(
         images["depth"], normals=images.get("normal"), camera=None,
         depth_layers=[images[f"depth{k}"] for k in layers],
         facing_layers=[images[f"facing{k}"] for k in layers], beauty=beauty,
@@ -428,12 +465,13 @@ def waiting_status(node, scene, frame):
     return None
 
 
-def compute_frame(scene, frame, since=0.0, outcome="written", wait=True):
-    """Computes every SSAO node of `scene` from its export of `frame` written since `since` (a
-    time.time(); a render that started before the add-on turned a saved file's group nodes
-    back into SSAO nodes exports where the file was saved). Returns {node name: AO, or None
-    where it failed}. A node that failed gets an AO of 1 (the frame is `outcome` without its
-    AO), and the error is reported on the node and in the console. wait: compute_node's."""
+def compute_frame(scene, frame, since=0.0, outcome="written", wait=True, sequences=None):
+    """Computes every SSAO node of `scene` from its export of `frame` (the scene's current
+    frame) written since `since` (a time.time(); a render that started before the add-on turned
+    a saved file's group nodes back into SSAO nodes exports where the file was saved). Returns
+    {node name: AO, or None where it failed}. A node that failed gets an AO of 1 (the frame is
+    `outcome` without its AO), and the error is reported on the node and in the console. wait,
+    sequences: compute_node's."""
     done = {}
     for node in ssao_nodes(scene):
         # A render of this session may have exported where a saved file points (see above).
@@ -448,7 +486,8 @@ def compute_frame(scene, frame, since=0.0, outcome="written", wait=True):
                                    "connected to the compositor's output?)")
             start = time.perf_counter()
             stats = {}
-            ao = compute_node(node, scene, read_export(path), wait, run_stats=stats)
+            ao = compute_node(node, scene, read_export(path), wait, run_stats=stats,
+                              sequences=sequences)
             seconds = time.perf_counter() - start
             node.status = waiting_status(node, scene, frame) or \
                 f"Frame {frame}: {ao.shape[1]}x{ao.shape[0]} in {seconds * 1e3:.0f} ms"

@@ -13,6 +13,8 @@ inner_tree.py). Then:
     is over, a main-thread timer re-composites and rewrites every written frame with its own
     AO, then computes the current frame's AO and nudges the UI compositor, which re-composites
     the Render Result on screen.
+The frames of one animation render are one sequence (compute.Sequences), whose temporal filter
+averages each frame's AO with the frames before it; a still is computed alone.
 Changing a node property recomputes from the exported passes, without rendering.
 (Measured facts behind this design: docs/blender.md.)"""
 import atexit
@@ -69,6 +71,32 @@ def _remove(path):
 
 
 @bpy.app.handlers.persistent
+def _on_render_init(*_):
+    """Headless, a render job (a still, or every frame of -a) begins: its frames are one
+    sequence for the temporal filter (compute.Sequences). In the UI the frames are computed
+    after the job (_finish_rendered_frames)."""
+    state = session.current
+    if not bpy.app.background or state.helper_rendering():
+        return
+    _end_sequences()
+    state.sequences = compute.Sequences()
+
+
+@bpy.app.handlers.persistent
+def _on_render_done(*_):
+    """render_complete, render_cancel."""
+    if bpy.app.background and not session.current.helper_rendering():
+        _end_sequences()
+
+
+def _end_sequences():
+    state = session.current
+    if state.sequences is not None:
+        state.sequences.close()
+        state.sequences = None
+
+
+@bpy.app.handlers.persistent
 def _on_render_pre(scene, *_):
     state = session.current
     if state.helper_rendering():
@@ -113,7 +141,8 @@ def _on_render_post(scene, *_):
         _warn_movie_once(scene)
     # Headless, the scene's objects (the camera) still hold the frame the file was saved at.
     scene.frame_set(frame)
-    aos = compute.compute_frame(scene, frame, state.render_started)
+    aos = compute.compute_frame(scene, frame, state.render_started,
+                                sequences=state.sequences)
     # Nothing computed: the render's own composite is already the image without AO.
     if not _computed(aos) or compat.is_movie(scene.render.image_settings):
         return
@@ -270,6 +299,23 @@ def _finish_rendered_frames():
         # Outside a render handler the helper scene can go: the next one copies the compositor
         # as it is now (before 5.0 a scene's tree cannot be swapped, only copied with it).
         recomposite.remove_helpers()
+    # The written frames are those of one animation render (the job is over): one sequence,
+    # so that the temporal filter averages each frame with those before it, as headless.
+    sequences = compute.Sequences()
+    try:
+        _finish_written_frames(state, sequences)
+        last = state.pending_frames[-1] if state.pending_frames else None
+        state.pending_frames.clear()
+        scene = bpy.data.scenes.get(last[0]) if last else None
+        if scene is None or not compute.ssao_nodes(scene):
+            return
+        # The Render Result's frame: after an animation its last, as it was written.
+        _show_frame(scene, last[1], sequences)
+    finally:
+        sequences.close()
+
+
+def _finish_written_frames(state, sequences):
     while state.written_frames:
         scene_name, frame, output, passes = state.written_frames.pop(0)
         scene = bpy.data.scenes.get(scene_name)
@@ -280,7 +326,8 @@ def _finish_rendered_frames():
         current = scene.frame_current
         try:
             scene.frame_set(frame)
-            aos = compute.compute_frame(scene, frame, state.render_started)
+            aos = compute.compute_frame(scene, frame, state.render_started,
+                                        sequences=sequences)
             # Written again even when every node failed: the file has the AO of the frame
             # before, and must get none (the failed nodes' AO is now 1).
             if aos:
@@ -292,27 +339,22 @@ def _finish_rendered_frames():
         finally:
             scene.frame_set(current)
             _remove(passes)
-    last = state.pending_frames[-1] if state.pending_frames else None
-    state.pending_frames.clear()
-    scene = bpy.data.scenes.get(last[0]) if last else None
-    if scene is None or not compute.ssao_nodes(scene):
-        return
-    _show_frame(scene, last[1])
 
 
-def _show_frame(scene, frame):
+def _show_frame(scene, frame, sequences=None):
     """UI: the AO of the Render Result's frame, re-composited. The helper render a node needs
     renders in its own process (helper_process): the node shows the AO without it meanwhile,
-    and this runs again when it is done. After an animation the Render Result shows its last
-    frame and the scene is back at its own: that frame's camera for the AO (its helper
-    rendered here, at once), then the scene as it was."""
+    and this runs again when it is done (then alone). After an animation the Render Result
+    shows its last frame and the scene is back at its own: that frame's camera for the AO (its
+    helper rendered here, at once; in the animation's `sequences`), then the scene as it
+    was."""
     current = scene.frame_current
     try:
         if frame != current:
             scene.frame_set(frame)
         aos = compute.compute_frame(scene, frame, session.current.render_started,
-                                    outcome="shown",
-                                    wait=frame != current)
+                                    outcome="shown", wait=frame != current,
+                                    sequences=sequences)
     finally:
         if scene.frame_current != current:
             scene.frame_set(current)
@@ -448,8 +490,10 @@ def _on_save_post(*_):
     set_up_nodes()
 
 
-_HANDLERS = (("render_pre", _on_render_pre), ("render_post", _on_render_post),
-             ("render_write", _on_render_write), ("composite_pre", _on_composite_pre),
+_HANDLERS = (("render_init", _on_render_init), ("render_complete", _on_render_done),
+             ("render_cancel", _on_render_done), ("render_pre", _on_render_pre),
+             ("render_post", _on_render_post), ("render_write", _on_render_write),
+             ("composite_pre", _on_composite_pre),
              ("load_post", _on_load_post), ("save_pre", _on_save_pre),
              ("save_post", _on_save_post))
 

@@ -11,7 +11,8 @@ from . import compat, compute, handlers, inner_tree, session, ssao
 FACE_PARAMETERS = ("radius", "strength", "quality")
 # The sidebar's box titles: the library's groups, in compute.NODE_GROUPS's order, then the
 # add-on's settings.
-GROUP_TITLES = {"ao": "Occlusion", "quality": "Quality and cost", "shaping": "Shaping"}
+GROUP_TITLES = {"ao": "Occlusion", "quality": "Quality and cost", "shaping": "Shaping",
+                "execution": "Animation"}  # of execution, only temporal_frames
 SETTINGS_TITLE = "Helper render"
 # Chosen from the costs and gains measured in docs/blender.md, "Hidden surfaces and overscan".
 DEFAULT_HIDDEN_SURFACES = 'PEELED'

@@ -247,6 +247,20 @@ class AddonTest(unittest.TestCase):
                         "-o", out, "--quiet"], check=True)
         return read_exr(out)["AO"]
 
+    def cli_sequence_ao(self, folder, frames):
+        """The command-line tool's AO of the node's exports of frames 1..`frames` as one
+        sequence (--frames: its temporal filter), each with its frame's camera file."""
+        export = glob.glob(os.path.join(folder, "export", "ssao_*0001.exr"))
+        self.assertEqual(len(export), 1, export)
+        subprocess.run([CONFIG["cli"], export[0][:-len("0001.exr")] + "####.exr",
+                        "--frames", f"1-{frames}",
+                        "--camera", os.path.join(folder, "scene.camera.####.json"),
+                        "--radius", "0.8", "--depth-channel", "A", "--normal-channels", "R,G,B",
+                        "--ao-only", "-o", os.path.join(folder, "cli_ao.####.exr"), "--quiet"],
+                       check=True)
+        return [read_exr(os.path.join(folder, f"cli_ao.{frame:04d}.exr"))["AO"]
+                for frame in range(1, frames + 1)]
+
     def test_install_registers_the_node_in_the_filter_menu(self):
         script = ("import bpy; cls = bpy.types.Node.bl_rna_get_subclass_py('CompositorNodeSSAO'); "
                   "print('NODE', cls.bl_label); "
@@ -599,20 +613,37 @@ class AddonTest(unittest.TestCase):
 
     def test_animation_renders_every_frame_with_its_own_ao(self):
         folder = self.folder("anim")
-        blend = self.blender.build_scene("anim/scene", *ONE_LAYER, "--frames", "3",
+        blend = self.blender.build_scene("anim/scene", *ONE_LAYER, "--frames", "4",
                                          "--output", os.path.join(folder, "out_####.exr"),
                                          "--passes-dir", os.path.join(folder, "passes"))
-        log = self.blender.run(blend, "-a", env={
+        # From frame 4 a marker binds a copy of the camera (same animation, same pose): a cut.
+        cut = ("import bpy; s = bpy.context.scene; c = s.camera; d = c.copy(); "
+               "s.collection.objects.link(d); s.timeline_markers.new('a', frame=1).camera = c; "
+               "s.timeline_markers.new('b', frame=4).camera = d")
+        log = self.blender.run(blend, "--python-expr", cut, "-a", env={
             "SSAO_COMPOSITOR_EXPORT_DIR": os.path.join(folder, "export")})
-        self.assertEqual(log.count("with AO"), 3, log)
-        aos = self.assert_frames_are_beauty_times_ao(folder, 3)
-        # Each frame's AO is the command-line tool's on that frame's passes with that frame's
-        # camera (it turns: the wrong frame's camera rotates the normals).
-        for frame, ao in zip((1, 2, 3), aos):
-            cli = self.cli_ao(folder, os.path.join(folder, f"scene.camera.{frame:04d}.json"),
-                              frame)
+        self.assertEqual(log.count("with AO"), 4, log)
+        aos = self.assert_frames_are_beauty_times_ao(folder, 4)
+        # Frames 1-3 are one sequence: each frame's AO is the command-line tool's of that
+        # frame in a --frames run over the three frames' passes with their cameras (it turns:
+        # the wrong frame's camera rotates the normals), whose temporal filter averages it with
+        # the frames before it.
+        sequence = self.cli_sequence_ao(folder, 3)
+        for frame, ao, cli in zip((1, 2, 3), aos, sequence):
             np.testing.assert_allclose(ao, cli, atol=1e-5, err_msg=f"frame {frame}")
         self.assertGreater(float(np.abs(aos[0] - aos[2]).max()), 0.1, "the camera moves")
+        # The filter acts: frames 2 and 3 are not what each is alone; frame 1, with nothing
+        # before it, is, and frame 4, after the cut, too.
+        for frame, ao in enumerate(aos, start=1):
+            alone = self.cli_ao(folder, os.path.join(folder, f"scene.camera.{frame:04d}.json"),
+                                frame)
+            averaged = int(np.count_nonzero(np.abs(ao - alone) > 1e-3))
+            print(f"\n[measure] animation frame {frame}: {averaged} of {ao.size} px differ "
+                  "from the frame alone by more than 1e-3", file=sys.stderr)
+            if frame in (1, 4):
+                np.testing.assert_allclose(ao, alone, atol=1e-5, err_msg=f"frame {frame}")
+            else:
+                self.assertGreater(averaged, ao.size // 20, f"frame {frame}")
 
     def test_multilayer_output_holds_the_composite_with_ao(self):
         folder = self.folder("multilayer")
