@@ -34,10 +34,22 @@ def _on_overscan_changed(node, context):
     _on_parameter_changed(node, context)
 
 
+# Where the library's description speaks of its own calls, what the parameter means on the node.
+NODE_DESCRIPTIONS = {
+    "temporal_frames": "In an animation render (Ctrl+F12, blender -a), the AO averages this "
+                       "many frames: this one and the ones just before it, carried to its "
+                       "pixels through depth and camera; pixels the earlier frame did not see, "
+                       "near something that moved, or whose AO changed much take no part. "
+                       "Steadies the pattern's crawl on camera moves. 1: each frame alone (a "
+                       "still always is)",
+}
+
+
 def _property_for(desc):
     """A bpy property with the library's default, range, unit and description."""
     title = desc["name"].replace("_", " ").capitalize()
-    text = desc["description"] + (f" ({desc['unit']})" if desc["unit"] else "")
+    text = NODE_DESCRIPTIONS.get(desc["name"], desc["description"]) + \
+        (f" ({desc['unit']})" if desc["unit"] else "")
     if desc["type"] == ssao.PARAM_STRING:
         items = [(c, c.replace("_", " ").capitalize(), "") for c in desc["choices"]]
         return bpy.props.EnumProperty(name=title, description=text, items=items,
