@@ -25,7 +25,7 @@ import zipfile
 import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-import flicker  # noqa: E402  (benchmarks/flicker.py: View, carried, flicker)
+import flicker  # noqa: E402  (benchmarks/flicker.py: read_channels, View, flicker, rmse)
 
 REPO_ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 BUILD_SCENE = os.path.join(REPO_ROOT, "tests", "blender", "build_ssao_scene.py")
@@ -35,17 +35,6 @@ EACH_FRAME_ALONE = (
     "compute = next(m for n, m in sys.modules.items() if n.endswith('ssao_compositor.compute'))\n"
     "for _, node in compute.all_ssao_nodes():\n"
     "    node.temporal_frames = 1\n")
-
-
-def read_layers(path):
-    import OpenImageIO as oiio
-    image = oiio.ImageInput.open(path)
-    if image is None:
-        raise SystemExit(f"cannot read {path}: {oiio.geterror()}")
-    spec = image.spec()
-    pixels = np.array(image.read_image(0, 0, 0, spec.nchannels, "float"))
-    image.close()
-    return {name: pixels[:, :, k] for k, name in enumerate(spec.channelnames)}
 
 
 def blender(args, scripts, *arguments):
@@ -88,14 +77,17 @@ def main():
                 "-o", os.path.join(out, "alone", "out_####"), "-a")
         frames, reference, filtered, alone = [], [], [], []
         for frame in range(1, args.frames + 1):
-            layers = read_layers(os.path.join(out, "filtered", f"out_{frame:04d}.exr"))
-            depth = layers["ViewLayer.Depth.Z"]
+            name = f"out_{frame:04d}.exr"
+            try:
+                depth, ao_pass, ao = flicker.read_channels(os.path.join(out, "filtered", name),
+                                                           ["Depth.Z", "AO.R", "SSAO.AO.V"])
+                alone += flicker.read_channels(os.path.join(out, "alone", name), ["SSAO.AO.V"])
+            except flicker.kit.StepFailed as error:
+                raise SystemExit(str(error)) from None
             frames.append((depth, flicker.View(os.path.join(out, f"scene.camera.{frame:04d}.json"),
                                                args.width, args.height)))
-            reference.append(np.where(flicker.geometry(depth), layers["ViewLayer.AO.R"], 1.0))
-            filtered.append(layers["SSAO.AO.V"])
-            alone.append(read_layers(os.path.join(out, "alone",
-                                                  f"out_{frame:04d}.exr"))["SSAO.AO.V"])
+            reference.append(np.where(flicker.geometry(depth), ao_pass, 1.0))
+            filtered.append(ao)
         print(f"{args.frames} frames, {args.width}x{args.height}, Cycles AO pass at "
               f"{args.samples} spp, {os.path.basename(args.blender)}")
         print("| AO | RMSE vs AO pass | flicker | flicker, occluded |")
