@@ -238,13 +238,17 @@ class AddonTest(unittest.TestCase):
                     os.path.join(folder, "passes", f"{frame:04d}.exr"))[0]
                 for frame in range(1, frames + 1)]
 
+    # The command-line tool's reading of the node's exports (Normal in RGB, Depth in A) with
+    # the test scene's radius, writing the AO alone.
+    CLI_ON_EXPORTS = ("--radius", "0.8", "--depth-channel", "A", "--normal-channels", "R,G,B",
+                      "--ao-only", "--quiet")
+
     def cli_ao(self, folder, camera_json, frame=1):
         export = glob.glob(os.path.join(folder, "export", f"ssao_*{frame:04d}.exr"))
         self.assertEqual(len(export), 1, export)
         out = os.path.join(folder, "cli_ao.exr")
-        subprocess.run([CONFIG["cli"], export[0], "--camera", camera_json, "--radius", "0.8",
-                        "--depth-channel", "A", "--normal-channels", "R,G,B", "--ao-only",
-                        "-o", out, "--quiet"], check=True)
+        subprocess.run([CONFIG["cli"], export[0], "--camera", camera_json, "-o", out,
+                        *self.CLI_ON_EXPORTS], check=True)
         return read_exr(out)["AO"]
 
     def cli_sequence_ao(self, folder, frames):
@@ -255,8 +259,7 @@ class AddonTest(unittest.TestCase):
         subprocess.run([CONFIG["cli"], export[0][:-len("0001.exr")] + "####.exr",
                         "--frames", f"1-{frames}",
                         "--camera", os.path.join(folder, "scene.camera.####.json"),
-                        "--radius", "0.8", "--depth-channel", "A", "--normal-channels", "R,G,B",
-                        "--ao-only", "-o", os.path.join(folder, "cli_ao.####.exr"), "--quiet"],
+                        "-o", os.path.join(folder, "cli_ao.####.exr"), *self.CLI_ON_EXPORTS],
                        check=True)
         return [read_exr(os.path.join(folder, f"cli_ao.{frame:04d}.exr"))["AO"]
                 for frame in range(1, frames + 1)]
