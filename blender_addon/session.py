@@ -24,7 +24,7 @@ class Session:
         self.pending_frames = []   # UI: (scene name, frame) rendered, waiting for the timer
         self.written_frames = []   # UI: (scene name, frame, output file, passes file), Ctrl+F12
         self.recomposited = {}     # headless: (scene name, frame) -> (passes file, AO layers)
-        self.sequences = None      # headless: the render's compute.Sequences, render_init on
+        self.sequences = None      # headless: the render job's compute.Sequences (init to end)
         self.movie_warned = set()  # scenes told once that a movie cannot be written again
         self.run_with_writes = None  # what the window manager property's update runs
         self.nudge_scene = None    # the scene whose UI compositor is nudged until it runs

@@ -220,7 +220,7 @@ def _ambient_occlusion(job, depth, *, normals=None, camera, depth_layers=(), fac
             job.set_image(f"facing{k + 2}", layer)
         if output_window is not None:
             job.set_output_window(x, y)
-        elif own_job is None:  # a window of the sequence's frame before
+        else:  # cleared: a Sequence's job keeps the window of the frame before
             job.set_output_window(0, 0, enable=False)
         job.set_image("ao", ao)
         if beauty is not None:
