@@ -1,8 +1,10 @@
 // SPDX-License-Identifier: MIT
 #include "pass_runner.h"
 
+#include <chrono>
 #include <cstdio>
 #include <filesystem>
+#include <thread>
 
 #include "tools/error.h"
 
@@ -43,17 +45,41 @@ RunningPass PassRunner::start(const std::string& what, const std::string& name,
     std::fprintf(file, "\n(in %s)\n\n", scene_folder.c_str());
     std::fclose(file);
   }
+  pass.args = std::move(args);
   pass.process =
-      std::make_unique<RunningProcess>(executable, args, scene_folder, pass.log, pass.output);
+      std::make_unique<RunningProcess>(executable, pass.args, scene_folder, pass.log, pass.output);
   return pass;
 }
 
 double PassRunner::finish(RunningPass& pass) const {
-  // The image is complete once POV-Ray closes it; its shutdown after that is not waited for.
-  const RenderResult result = pass.process->wait_for_output();
-  if (result.output_written) return result.seconds;
-  std::error_code ec;
-  if (result.exit_status == 0 && fs::is_regular_file(pass.output, ec)) return result.seconds;
+  double seconds = 0.0;
+  RenderResult result;
+  while (true) {
+    // The image is complete once POV-Ray closes it; its shutdown after that is not waited for.
+    result = pass.process->wait_for_output();
+    seconds += result.seconds;
+    if (result.output_written) return seconds;
+    std::error_code ec;
+    if (result.exit_status == 0 && fs::is_regular_file(pass.output, ec)) return seconds;
+    if (pass.attempts >= kStartupAttempts || !povray_startup_timed_out(pass.log, pass.log_start))
+      break;
+    // Nothing was rendered: a busy machine, not the scene. Wait a little longer each time.
+    const int wait_ms = 500 << (pass.attempts - 1);
+    ++pass.attempts;
+    if (FILE* file = std::fopen(pass.log.c_str(), "a")) {
+      std::fprintf(file,
+                   "\npovray-ssao: POV-Ray's worker thread did not start in time (a busy "
+                   "machine?); run %d of %d in %d ms\n\n",
+                   pass.attempts, kStartupAttempts, wait_ms);
+      std::fclose(file);
+    }
+    pass.log_start = fs::file_size(pass.log, ec);
+    if (ec) pass.log_start = 0;
+    std::this_thread::sleep_for(std::chrono::milliseconds(wait_ms));
+    if (InterruptGuard::interrupted()) throw ssao_tools::Error("interrupted; nothing written");
+    pass.process = std::make_unique<RunningProcess>(executable, pass.args, scene_folder, pass.log,
+                                                    pass.output);
+  }
   const std::string parse_error = povray_parse_error(pass.log);
   if (!parse_error.empty()) {
     // POV-Ray's own diagnosis says it all: the file, the line and what is wrong.
@@ -63,6 +89,7 @@ double PassRunner::finish(RunningPass& pass) const {
   std::string message = "POV-Ray failed on the " + pass.what;
   message += result.exit_status != 0 ? " (exit status " + std::to_string(result.exit_status) + ")"
                                      : " (no image written)";
+  if (pass.attempts > 1) message += ", run " + std::to_string(pass.attempts) + " times";
   message += ". Its last messages:\n" + povray_error_lines(pass.log);
   if (!keep) message += "(--keep DIR keeps the wrappers and the full logs)";
   while (!message.empty() && message.back() == '\n') message.pop_back();

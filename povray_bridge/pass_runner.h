@@ -4,6 +4,7 @@
 // into <name>.exr with its log beside it. --keep copies them all when the image is done.
 #pragma once
 
+#include <cstdint>
 #include <memory>
 #include <string>
 #include <vector>
@@ -18,10 +19,15 @@ namespace povray_ssao {
 struct RunningPass {
   std::string what;  // "depth pass", for messages
   std::string output, log;
+  std::vector<std::string> args;            // POV-Ray's command line, for a restart
   std::unique_ptr<RunningProcess> process;  // null: not started
+  int attempts = 1;
+  uintmax_t log_start = 0;  // where this run's messages begin in the log
 };
 
 struct PassRunner {
+  static constexpr int kStartupAttempts = 4;
+
   std::string executable;
   std::string scene_folder;
   std::string scene_name;  // the file the wrappers include, in scene_folder
@@ -40,6 +46,9 @@ struct PassRunner {
 
   // Waits for the run; returns its wall-clock seconds. Throws with POV-Ray's own messages when
   // it failed or wrote no image; POV-Ray's parse error when it could not parse the scene.
+  // A run whose worker thread did not start in time (POV-Ray 3.7 gives it a few seconds, which
+  // a loaded machine can exceed) rendered nothing: it is started again, up to
+  // kStartupAttempts runs in all, each retry noted in the log.
   double finish(RunningPass& pass) const;
 
   // POV-Ray's parse error as the user needs it: one that POV-Ray reports after the scene's

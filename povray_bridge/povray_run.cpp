@@ -247,6 +247,13 @@ std::string povray_error_lines(const std::string& log_path, size_t max_lines) {
   return out;
 }
 
+bool povray_startup_timed_out(const std::string& log_path, uintmax_t from) {
+  std::ifstream file(log_path, std::ios::binary);
+  file.seekg(static_cast<std::streamoff>(from));
+  const std::string text((std::istreambuf_iterator<char>(file)), std::istreambuf_iterator<char>());
+  return text.find("Timed out waiting for worker thread startup") != std::string::npos;
+}
+
 std::string povray_parse_error(const std::string& log_path) {
   // POV-Ray wraps its messages at 80 columns (anywhere between words, "Parse Error:" included);
   // the continuation lines start with a space.

@@ -6,6 +6,7 @@
 #include <sys/types.h>
 
 #include <chrono>
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -69,6 +70,11 @@ std::string povray_error_lines(const std::string& log_path, size_t max_lines = 1
 // 'sphere', box found instead" (its wrapped lines joined; "Possible Parse Error" warnings
 // skipped), or "" when the log has none.
 std::string povray_parse_error(const std::string& log_path);
+
+// Whether a log, from byte `from` on, shows that POV-Ray gave up waiting for its worker thread to
+// start ("Timed out waiting for worker thread startup"): it rendered nothing, and a second run
+// may well succeed.
+bool povray_startup_timed_out(const std::string& log_path, uintmax_t from = 0);
 
 // Width and height set by an INI file (Width=, Height=, +W, +H before the first [section]);
 // 0 for a value it does not set. Throws ssao_tools::Error if the file cannot be read.

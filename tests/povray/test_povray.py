@@ -1193,6 +1193,53 @@ sphere {{ <0, 1, 0>, 1 pigment {{ rgb 1 }} }}
             os.kill(pid, 9)
         self.assertEqual(left, [], "POV-Ray renders outlived a killed povray-ssao")
 
+    def busy_povray(self, failures):
+        """A povray whose first `failures` runs of each pass fail as POV-Ray 3.7 does when its
+        worker thread starts too late on a loaded machine; the runs after them are POV-Ray's."""
+        script = self.path("busy-povray")
+        with open(script, "w") as f:
+            f.write(f"""#!/bin/sh
+for arg in "$@"; do case "$arg" in +O*) out="${{arg#+O}}";; esac; done
+count="{self.dir}/$(basename "$out").failures"
+n=$(cat "$count" 2>/dev/null || echo 0)
+if [ "$n" -lt {failures} ]; then
+  echo $((n + 1)) > "$count"
+  echo "Timed out waiting for worker thread startup" >&2
+  exit 1
+fi
+exec {POVRAY} "$@"
+""")
+        os.chmod(script, 0o755)
+        return script
+
+    def test_povray_startup_timeout_is_run_again(self):
+        # Seen in CI under load: POV-Ray gives its worker thread a few seconds to start, then
+        # exits having rendered nothing. Such a run is not the scene's fault: run it again.
+        scene = self.copy_scene("sphere_on_plane.pov")
+        reference = self.path("reference.exr")
+        self.assert_ok(self.run_bridge(scene, "-o", self.path("reference.png"), "--exr",
+                                       reference, "+W48", "+H36"), reference)
+        out, exr, keep = self.path("out.png"), self.path("out.exr"), self.path("keep")
+        proc = self.run_bridge(scene, "-o", out, "--exr", exr, "--keep", keep, "+W48", "+H36",
+                               "--povray", self.busy_povray(2))
+        self.assert_ok(proc, out, exr)
+        names, pixels = read_image(exr)
+        names_ref, pixels_ref = read_image(reference)
+        self.assertEqual(names, names_ref)
+        self.assertEqual(np.abs(pixels - pixels_ref).max(), 0.0, self.detail(proc))
+        with open(os.path.join(keep, "depth.log")) as f:
+            log = f.read()
+        self.assertIn("run 3 of 4", log)
+        self.assertEqual(log.count("Timed out waiting for worker thread startup"), 2)
+
+    def test_povray_that_never_starts_fails_clearly(self):
+        scene = self.copy_scene("sphere_on_plane.pov")
+        out, exr = self.path("out.png"), self.path("out.exr")
+        proc = self.run_bridge(scene, "-o", out, "--exr", exr, "+W48", "+H36",
+                               "--povray", self.busy_povray(99))
+        self.assert_fails(proc, "failed on the", "run 4 times",
+                          "Timed out waiting for worker thread startup", outputs=[out, exr])
+
     def test_fisheye_camera(self):
         scene = self.copy_scene("fisheye.pov", """#version 3.7;
 camera { fisheye location <0, 1, -5> look_at 0 angle 180 }
