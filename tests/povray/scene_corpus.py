@@ -55,6 +55,7 @@ import numpy as np
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
 from image_files import read_image  # noqa: E402
+from povray_process import run_povray  # noqa: E402
 
 DEFAULT_EXAMPLES = ["/usr/share/povray-3.7/scenes", "/usr/share/doc/povray/examples"]
 SKIP = 77
@@ -265,8 +266,7 @@ class Corpus:
         cmd = ([self.args.povray, "+I" + scene, "+O" + output, "+L" + folder] + RENDER_FLAGS
                + list(extra))
         try:
-            proc = subprocess.run(cmd, cwd=folder, capture_output=True, text=True,
-                                  errors="replace", timeout=self.args.timeout)
+            proc = run_povray(cmd, cwd=folder, errors="replace", timeout=self.args.timeout)
         except subprocess.TimeoutExpired:
             return "timeout"
         if proc.returncode != 0 or not os.path.isfile(os.path.join(folder, output)):

@@ -32,6 +32,7 @@ import numpy as np
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
 from image_files import read_image  # noqa: E402
+from povray_process import run_povray  # noqa: E402
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 SCENES = os.path.join(HERE, "scenes")
@@ -268,8 +269,7 @@ class PovTestCase(unittest.TestCase):
         """Renders with POV-Ray directly (not through the bridge); returns the output path."""
         cmd = [POVRAY, "+I" + scene, "+O" + output, f"+W{W}", f"+H{H}", "-D", "-P", "-V",
                "+L" + POV_INCLUDES, "+L" + os.path.dirname(scene)] + list(options)
-        proc = subprocess.run(cmd, capture_output=True, text=True, timeout=timeout,
-                              cwd=os.path.dirname(scene))
+        proc = run_povray(cmd, timeout=timeout, cwd=os.path.dirname(scene))
         self.assertEqual(proc.returncode, 0, " ".join(cmd) + "\n" + proc.stderr[-3000:])
         self.assertTrue(os.path.isfile(output), output)
         return output
@@ -448,7 +448,7 @@ plane { y, 0 SSAOTexture(texture { pigment { rgb 1 } }) }
         scene = self.copy_scene("sphere_on_plane.pov")
         cmd = [POVRAY, "+I" + scene, "+O" + self.path("x.exr"), "+W8", "+H6", "-D", "+FE",
                "+L" + POV_INCLUDES, "Declare=SSAOPass=3"]
-        proc = subprocess.run(cmd, capture_output=True, text=True, timeout=60)
+        proc = run_povray(cmd, timeout=60)
         self.assertNotEqual(proc.returncode, 0)
         self.assertIn("SSAOPass must be 0, 1 or 2", proc.stderr)
         nobasis = self.copy_scene("nobasis.pov", """#version 3.7;
@@ -458,7 +458,7 @@ sphere { 0, 1 SSAOTexture(texture { pigment { rgb 1 } }) }
 """)
         cmd = [POVRAY, "+I" + nobasis, "+O" + self.path("y.exr"), "+W8", "+H6", "-D", "+FE",
                "+L" + POV_INCLUDES, "Declare=SSAOPass=1"]
-        proc = subprocess.run(cmd, capture_output=True, text=True, timeout=60)
+        proc = run_povray(cmd, timeout=60)
         self.assertNotEqual(proc.returncode, 0)
         self.assertIn("SSAOCamera", proc.stderr)
         # ... while the beauty pass of the same scene needs no camera basis.
