@@ -119,7 +119,13 @@ def step():
             log(f"timeout after {TIMEOUT:.0f} s")
             quit_blender(1)
         if not STATE["started"]:
-            show_render_properties()
+            # The probe writes to the scene: drawn before the render starts, never beside the
+            # render thread (a write then crashed Blender 3.4.1 once).
+            if "shown" not in STATE:
+                show_render_properties()
+                STATE["shown"] = time.monotonic()
+            if not PROBE and time.monotonic() - STATE["shown"] < 10:
+                return 0.2
             if FAIL_FRAME is not None:
                 break_frame(FAIL_FRAME)
             window = bpy.context.window_manager.windows[0]
