@@ -37,6 +37,8 @@ CONFIG = {}
 # compare the node's AO with the command-line tool's on the same exported passes, and for the
 # UI and EEVEE tests, which also run with the defaults (the *_with_hidden_surfaces_* tests).
 ONE_LAYER = ("--hidden-surfaces", "NONE", "--overscan", "0")
+# The UI tests run Blender with a window, on a virtual X server.
+needs_xvfb = unittest.skipUnless(shutil.which("xvfb-run"), "needs xvfb-run (apt-get install xvfb)")
 
 
 def read_exr(path):
@@ -696,7 +698,7 @@ class AddonTest(unittest.TestCase):
         for device, ao in aos.items():
             np.testing.assert_allclose(ao, aos["CPU"], rtol=0, atol=1e-5, err_msg=device)
 
-    @unittest.skipUnless(shutil.which("xvfb-run"), "needs xvfb-run (apt-get install xvfb)")
+    @needs_xvfb
     def test_ui_f12_and_a_property_change_apply_the_ao(self):
         # F12 in the UI with the compositor and the Render Result in view, then a property
         # change: the Render Result's Composite must be its Combined x the node's AO each time
@@ -704,13 +706,13 @@ class AddonTest(unittest.TestCase):
         # 5.2 this runs on its default GPU compositor.
         self.ui_f12("ui_f12", *ONE_LAYER)
 
-    @unittest.skipUnless(shutil.which("xvfb-run"), "needs xvfb-run (apt-get install xvfb)")
+    @needs_xvfb
     def test_ui_f12_with_hidden_surfaces_and_overscan(self):
         # The same with the helper render (hidden_surfaces.py) rendered from the main-thread
         # timer after F12 and reused, not rendered again, by the property change.
         self.ui_f12("ui_f12_layers", "--hidden-surfaces", "PEELED", "--overscan", "8")
 
-    @unittest.skipUnless(shutil.which("xvfb-run"), "needs xvfb-run (apt-get install xvfb)")
+    @needs_xvfb
     def test_ui_changing_hidden_surfaces_renders_the_helper_again(self):
         # In the UI, F12 with the defaults (hidden surfaces and a band), and F12 again while
         # the first one's helper process renders; then the two settings changed from the node:
@@ -758,7 +760,7 @@ class AddonTest(unittest.TestCase):
         self.assertEqual(report["change"]["renders_meanwhile"], 0)
         self.assertTrue(report["change"]["status"].startswith("Frame 1"), report["change"])
 
-    @unittest.skipUnless(shutil.which("xvfb-run"), "needs xvfb-run (apt-get install xvfb)")
+    @needs_xvfb
     def test_ui_animation_writes_each_frame_with_its_own_ao(self):
         # Ctrl+F12 in the UI, where render handlers run in the render thread: every written
         # frame must carry its own AO, the one a headless render (-a) of the same frame gets.
@@ -766,7 +768,7 @@ class AddonTest(unittest.TestCase):
         # beauty (before, it kept the AO the frames were composited with during the job).
         self.ui_animation("ui_anim", *ONE_LAYER)
 
-    @unittest.skipUnless(shutil.which("xvfb-run"), "needs xvfb-run (apt-get install xvfb)")
+    @needs_xvfb
     def test_ui_animation_with_hidden_surfaces_and_overscan(self):
         # The same with the helper render of each frame (its own camera) after the job.
         self.ui_animation("ui_anim_layers", "--hidden-surfaces", "PEELED", "--overscan", "8")
@@ -797,7 +799,7 @@ class AddonTest(unittest.TestCase):
             np.testing.assert_allclose(ui_out, out, atol=1e-4, err_msg=f"frame {frame}")
         self.assertGreater(float(np.abs(ui_aos[0] - ui_aos[2]).max()), 0.1, "the camera moves")
 
-    @unittest.skipUnless(shutil.which("xvfb-run"), "needs xvfb-run (apt-get install xvfb)")
+    @needs_xvfb
     def test_ui_animation_of_many_frames_does_not_hang(self):
         # Ctrl+F12 with Blender's render window drawing every frame as it renders (issue 20):
         # saving a frame's passes from the render thread deadlocked Blender 5.2 against the
