@@ -149,9 +149,12 @@ TEST(Temporal, CameraMoveFlickersLessWithTheFilter) {
       flickers[0], flickers[1], alone, geometry);
   EXPECT_GT(flickers[0], 0.005) << "the move must flicker to compare";
   EXPECT_LT(flickers[1], 0.7 * flickers[0]);
-  // Not averaged: what the move uncovered, and pixels whose nearest pixel in an earlier frame
-  // disagrees in depth by more than 0.5 % (the floor, steep in depth): 34 % here. Motion found
-  // at the boxes' edges would take every pixel of their contact shadows.
+  // Counted here (34 %): pixels no earlier frame reached (what the move uncovered), and pixels
+  // whose earlier frames hold the very value they have (the estimate takes few distinct values
+  // where little occludes), whose average is that value again: counted inside the filter, 2 %
+  // of the occluded pixels took no earlier frame. A depth agreement of 5 % instead of 0.5 %
+  // counts 1149 instead of 1189 and leaves the flicker as it is. Motion found at the boxes'
+  // edges would take every pixel of their contact shadows.
   EXPECT_LT(alone, geometry / 2);
 }
 
