@@ -15,10 +15,12 @@ whose depth agrees with the point's within 0.5 % (so what the move uncovered doe
 same RMS over the occluded pixels alone (reference AO < 0.9) is where a crawling pattern shows.
 A converged render's flicker is its own noise plus the resampling.
 
-    benchmarks/flicker.py [--kit DIR] [--threads N] [--set NAME=VALUE ...] [--update-docs]
+    benchmarks/flicker.py [--kit DIR] [--threads N] [--set NAME=VALUE ...] [--layers]
+                          [--update-docs]
 
 prints per scene the RMSE against the reference (mean over the frames) and both flicker
-figures, for libssao (the default, and each --set variant given) and for Cycles; then, for a
+figures, for libssao (the default, and each --set variant given; with --layers also with the
+2nd and 3rd hits and a guard band, as the Blender node's defaults) and for Cycles; then, for a
 box sliding over `contact`'s floor (the camera still), the error where the AO changed, with
 and without the temporal filter: a trail behind a moving object would show there. The renders
 are cached in the kit folder (about 25 min the first time on 2 cores); --update-docs puts the
@@ -44,6 +46,9 @@ CYCLES_SPP = (16, 64)
 SCENES = ("contact", "thin", "cavity", "depth_range", "ortho", "heavy")
 OCCLUDED_BELOW = 0.9
 DEPTH_AGREEMENT = 0.005
+# --layers: the guard band of the layered rows (speed_error.py's 64 px at 640x360, scaled).
+LAYERS_BAND = 32
+NO_HIT = 1e10  # Blender's depth where a ray hits nothing
 
 
 def read_channels(path, suffixes):
@@ -168,6 +173,60 @@ def library_sequence(args, prefixes, settings):
                 for k in range(len(prefixes))]
 
 
+def merged_with_band(band_plane, frame_plane, band):
+    """The layers file's plane (its band around the frame) with the frame's pixels taken from
+    the reference render, as the Blender add-on gives them to the library."""
+    out = band_plane.copy()
+    height, width = frame_plane.shape[:2]
+    out[band:band + height, band:band + width] = frame_plane
+    return out
+
+
+def layered_sequence(args, blender_version, scene, prefixes):
+    """libssao's AO of every frame of a move with the 2nd and 3rd hits and a LAYERS_BAND px guard
+    band (what the Blender node's helper render adds by default: benchmark_layers.py on each
+    frame's camera), one ssao.Sequence from frame to frame as the node's animation renders.
+    Hits not behind the depth the library is given are dropped and the later ones move up, as
+    ssao_eval --layers does."""
+    os.environ.setdefault("SSAO_LIBRARY", args.library)
+    sys.path.insert(0, os.path.join(kit.REPO_ROOT, "core", "python"))
+    import ssao
+    with open(prefixes[0] + ".json", encoding="utf-8") as f:
+        radius = json.load(f)["ao_distance"]
+    shot = ssao.Sequence()
+    aos = []
+    for k, prefix in enumerate(prefixes):
+        layers = kit.kit_layers(args, blender_version, scene, SIZE, band=LAYERS_BAND,
+                                truck_px=k * STEP_PX)
+        depth, nx, ny, nz = read_channels(prefix + ".exr",
+                                          ["Depth.Z", "Normal.X", "Normal.Y", "Normal.Z"])
+        band_planes = read_channels(layers, ["Depth.Z", "Normal.X", "Normal.Y", "Normal.Z",
+                                             "Depth2.Z", "Facing2.V", "Depth3.Z", "Facing3.V"])
+        big_depth = merged_with_band(band_planes[0], depth, LAYERS_BAND)
+        normals = np.stack([merged_with_band(b, f, LAYERS_BAND)
+                            for b, f in zip(band_planes[1:4], (nx, ny, nz))], axis=-1)
+        # Hits behind the depth, nearest first; the places left empty are "no hit".
+        hits = np.stack(band_planes[4:8:2], axis=-1)
+        facing = np.stack(band_planes[5:8:2], axis=-1)
+        behind = hits > big_depth[:, :, None]
+        order = np.argsort(np.where(behind, hits, np.inf), axis=-1, kind="stable")
+        hits = np.take_along_axis(np.where(behind, hits, NO_HIT), order, axis=-1)
+        facing = np.take_along_axis(np.where(behind, facing, 0.0), order, axis=-1)
+        with open(prefix + ".camera.json", encoding="utf-8") as f:
+            camera = json.load(f)
+        ao = shot.ambient_occlusion(
+            np.ascontiguousarray(big_depth, dtype=np.float32), frame=k,
+            normals=np.ascontiguousarray(normals, dtype=np.float32), camera=camera,
+            depth_layers=[np.ascontiguousarray(hits[:, :, j], dtype=np.float32)
+                          for j in range(2)],
+            facing_layers=[np.ascontiguousarray(facing[:, :, j], dtype=np.float32)
+                           for j in range(2)],
+            output_window=(LAYERS_BAND, LAYERS_BAND, SIZE[0], SIZE[1]), radius=radius,
+            threads=args.threads)
+        aos.append(np.where(geometry(depth), ao, 1.0))
+    return aos
+
+
 def measure(args, blender_version, variants):
     """Rows {scene, method, rmse, flicker, flicker_occluded} per scene: libssao's variants
     (label, settings) and Cycles at CYCLES_SPP and REFERENCE_SPP."""
@@ -181,6 +240,9 @@ def measure(args, blender_version, variants):
             reference_aos.append(np.where(geometry(depth), ao, 1.0))
         methods = [("libssao " + name, library_sequence(args, reference, settings))
                    for name, settings in variants]
+        if args.layers:
+            methods.append(("libssao layers + %d px band" % LAYERS_BAND,
+                            layered_sequence(args, blender_version, scene, reference)))
         for samples in CYCLES_SPP:
             aos = []
             for prefix in sequence(args, blender_version, scene, samples):
@@ -264,8 +326,17 @@ def markdown(rows):
 SECTION = "## Flicker on camera moves"
 
 
+LAYERS_TEXT = (
+    "`libssao layers + %d px band`: with what the Blender node's helper render adds by default, "
+    "the 2nd and 3rd surface hits with their facing and a guard band, rendered for each frame's "
+    "camera at 1 spp (`scripts/blender/benchmark_layers.py --truck-px`), hits not behind the "
+    "frame's depth dropped as `ssao_eval --layers` does, one `ssao.Sequence` over the frames "
+    "as the node's animation renders." % LAYERS_BAND)
+
+
 def section(rows, moving, command, machine):
     """This benchmark's section of docs/performance.md."""
+    layered = any("layers" in r["method"] for r in rows)
     return "\n".join([
         SECTION,
         "",
@@ -283,6 +354,7 @@ def section(rows, moving, command, machine):
         "",
         markdown(rows),
         "",
+    ] + ([LAYERS_TEXT, ""] if layered else []) + [
         moving_text(moving),
         "",
     ])
@@ -318,6 +390,13 @@ def parse_args(argv=None):
                         help="comma-separated kit scenes (default: all six)")
     parser.add_argument("--set", action="append", default=[], metavar="NAME=VALUE[,NAME=VALUE]",
                         help="also measure libssao with these settings (repeatable)")
+    parser.add_argument("--layers", action="store_true",
+                        help="also measure libssao with the 2nd and 3rd hits and a %d px guard "
+                             "band, as the Blender node's defaults (renders them into the kit, "
+                             "1 spp a frame)" % LAYERS_BAND)
+    parser.add_argument("--library",
+                        default=os.path.join(kit.REPO_ROOT, "build", "lib", "libssao.so"),
+                        help="the library of the --layers rows (the Python module's)")
     parser.add_argument("--update-docs", action="store_true",
                         help="write the table into docs/performance.md (section \"%s\")"
                              % SECTION[3:])
@@ -359,6 +438,7 @@ def main():
     print(moving_text(moving))
     if args.update_docs:
         command = "benchmarks/flicker.py" + "".join(" --set " + s for s in args.set) + (
+            " --layers" if args.layers else "") + (
             " --scenes " + ",".join(args.scenes) if list(args.scenes) != list(SCENES) else "")
         machine = kit.machine_description(args, blender_version)
         update_docs(section(rows, moving, command + " --update-docs", machine))

@@ -223,18 +223,24 @@ def kit_render(args, blender_version, scene, size, samples, seed=1, border=None,
     return prefix
 
 
-def kit_layers(args, blender_version, scene, size):
-    """The path of a scene's cached layers file (extra depth layers and a guard band), rendering
-    it first if it is not there."""
+def kit_layers(args, blender_version, scene, size, band=GUARD_BAND, truck_px=None):
+    """The path of a scene's cached layers file (extra depth layers and a guard band of `band`
+    pixels), rendering it first if it is not there; with truck_px, of a frame of a camera move
+    (kit_render's)."""
     arguments = ["--scene", scene, "--width", str(size[0]), "--height", str(size[1]),
-                 "--overscan", str(GUARD_BAND)]
-    name = "%s-layers-%s" % (label(scene, size),
-                             kit_key(blender_version, arguments, LAYERS_SOURCES))
+                 "--overscan", str(band)]
+    sources, move_label = LAYERS_SOURCES, ""
+    if truck_px is not None:
+        arguments += ["--truck-px", repr(float(truck_px))]
+        sources, move_label = LAYERS_SOURCES + [SEQUENCE_SCRIPT], "-truck%g" % truck_px
+    name = "%s-layers%s-%s" % (label(scene, size), move_label,
+                               kit_key(blender_version, arguments, sources))
     folder = os.path.join(args.kit, name)
     path = os.path.join(folder, "ref.layers.exr")
     if os.path.isfile(path):
         return path
-    log("kit: rendering the depth layers and a %d px band of %s" % (GUARD_BAND, label(scene, size)))
+    log("kit: rendering the depth layers and a %d px band of %s%s"
+        % (band, label(scene, size), move_label))
     partial = folder + ".partial"
     shutil.rmtree(partial, ignore_errors=True)
     os.makedirs(partial)
