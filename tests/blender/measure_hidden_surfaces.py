@@ -5,13 +5,15 @@ render, on the test scene (light) and on the same scene with a mesh of about 2M 
 
     blender -b --factory-startup -P tests/blender/measure_hidden_surfaces.py -- \\
         [--width 640 --height 360 --samples 16 --triangles 2000000 --rounds 3] [--cutouts]
-        [--baseline CHECKOUT]
+        [--baseline CHECKOUT | --compare-hits A,B]
 
 Prints one `[measure]` line per case: the beauty render's time (Cycles, CPU) and the helper's
-(3 hits, with and without a guard band), medians of --rounds after one warm-up, in one Blender.
+(the node's hits, with and without a guard band), medians of --rounds after one warm-up, in one
+Blender.
 With --baseline CHECKOUT (e.g. a `git worktree` of an earlier commit), the helper of that
 checkout's blender_addon/ and this one's instead, interleaved, and their ratio. --cutouts adds
-the cut-out scene's fence, leaves and curtain.
+the cut-out scene's fence, leaves and curtain. With --compare-hits A,B, the helper (no band)
+recording A hits and B hits instead, interleaved, and their ratio.
 """
 import argparse
 import importlib
@@ -47,7 +49,13 @@ def parse_args():
     parser.add_argument("--baseline", default=None, metavar="CHECKOUT",
                         help="instead, compare the helper (3 hits) with another checkout's "
                              "blender_addon/, interleaved (A B A B), medians of --rounds")
-    return parser.parse_args(argv)
+    parser.add_argument("--compare-hits", default=None, metavar="A,B",
+                        help="instead, the helper recording A hits against B hits (no band), "
+                             "interleaved, medians of --rounds")
+    args = parser.parse_args(argv)
+    if args.compare_hits is not None:
+        args.compare_hits = tuple(int(v) for v in args.compare_hits.split(","))
+    return args
 
 
 def heavy_mesh(scene, triangles):
@@ -82,14 +90,36 @@ def timed(function, rounds):
 def measure(scene, label, args):
     beauty = timed(lambda: bpy.ops.render.render(), args.rounds)
     results = {}
-    for hits, overscan in ((3, 0), (3, args.overscan), (1, args.overscan)):
+    hits = hidden_surfaces.MAX_HITS  # what the node's 'PEELED' asks for
+    for count, overscan in ((hits, 0), (hits, args.overscan), (1, args.overscan)):
         def helper():
             hidden_surfaces.forget()
-            hidden_surfaces.render_layers(scene, hits, overscan)
-        results[hits, overscan] = timed(helper, args.rounds)
-    print(f"[measure] {label}: beauty {beauty:.2f} s; helper 3 hits {results[3, 0]:.2f} s, "
-          f"3 hits + {args.overscan} px {results[3, args.overscan]:.2f} s, band only "
+            hidden_surfaces.render_layers(scene, count, overscan)
+        results[count, overscan] = timed(helper, args.rounds)
+    print(f"[measure] {label}: beauty {beauty:.2f} s; helper {hits} hits {results[hits, 0]:.2f} s, "
+          f"{hits} hits + {args.overscan} px {results[hits, args.overscan]:.2f} s, band only "
           f"{results[1, args.overscan]:.2f} s (Blender {bpy.app.version_string})", flush=True)
+
+
+def compare_hits(scene, label, args):
+    """The helper render (no band) recording args.compare_hits[0] hits against [1], interleaved."""
+    times = {count: [] for count in args.compare_hits}
+
+    def helper(count):
+        hidden_surfaces.forget()
+        start = time.perf_counter()
+        hidden_surfaces.render_layers(scene, count, 0)
+        return time.perf_counter() - start
+
+    for count in times:  # warm-up
+        helper(count)
+    for _ in range(args.rounds):
+        for count in times:
+            times[count].append(helper(count))
+    a, b = (statistics.median(times[c]) for c in args.compare_hits)
+    print(f"[measure] {label}: helper {args.compare_hits[0]} hits {a:.3f} s, "
+          f"{args.compare_hits[1]} hits {b:.3f} s (ratio {b / a:.3f}; medians of {args.rounds}, "
+          f"interleaved; Blender {bpy.app.version_string})", flush=True)
 
 
 def compare(scene, label, args, baseline):
@@ -150,6 +180,8 @@ def main():
         reference.build_cutouts(scene)
     run = measure if args.baseline is None else \
         (lambda s, label, a, b=baseline_module(args.baseline): compare(s, label, a, b))
+    if args.compare_hits is not None:
+        run = compare_hits
     name = "test scene" + (" with cut-outs" if args.cutouts else "")
     run(scene, f"{name} ({size})", args)
     triangles = heavy_mesh(scene, args.triangles)
