@@ -1,7 +1,8 @@
 # SPDX-License-Identifier: MIT
 # CMake toolchain: Windows x86-64 from Debian, with MinGW-w64's POSIX-threads GCC
 # (g++-mingw-w64-x86-64-posix: std::thread needs the posix flavour). The programs it builds run
-# here under Wine (CMAKE_CROSSCOMPILING_EMULATOR: ctest and GoogleTest's discovery use it).
+# here under Wine (CMAKE_CROSSCOMPILING_EMULATOR: ctest and GoogleTest's discovery use it),
+# through scripts/wine_run.sh, which runs a program again when Wine failed to launch it.
 # scripts/build_windows.sh uses it; docs/install.md ("Windows").
 set(CMAKE_SYSTEM_NAME Windows)
 set(CMAKE_SYSTEM_PROCESSOR x86_64)
@@ -20,5 +21,5 @@ set(CMAKE_FIND_ROOT_PATH_MODE_PACKAGE ONLY)
 set(CMAKE_EXE_LINKER_FLAGS_INIT "-static")
 find_program(SSAO_WINE NAMES wine)
 if(SSAO_WINE)
-  set(CMAKE_CROSSCOMPILING_EMULATOR ${SSAO_WINE})
+  set(CMAKE_CROSSCOMPILING_EMULATOR ${CMAKE_CURRENT_LIST_DIR}/wine_run.sh)
 endif()

@@ -26,6 +26,7 @@ import shlex
 import subprocess
 import sys
 import tempfile
+import time
 
 import numpy as np
 import OpenImageIO as oiio
@@ -89,18 +90,24 @@ def as_argument(value):
 
 
 def run(label, command, work, out, pixels, timeout, env=None):
-    """Runs one raw_ao; returns the AO (float32, flat) or None after printing why it failed."""
-    if os.path.exists(os.path.join(work, out)):
-        os.remove(os.path.join(work, out))  # a stale output must not pass for this run's
-    with tempfile.TemporaryFile("w+") as stderr:
-        try:
-            done = subprocess.run(command, cwd=work, env=env, stdin=subprocess.DEVNULL,
-                                  stdout=subprocess.DEVNULL, stderr=stderr, timeout=timeout)
-        except (OSError, subprocess.TimeoutExpired) as error:
-            print(f"[measure] {label}: FAILED: {error}\n    {shlex.join(command)}")
-            return None
-        stderr.seek(0)
-        message = stderr.read()
+    """Runs one raw_ao; returns the AO (float32, flat) or None after printing why it failed.
+    A run that failed without a word and wrote nothing is run again (3 runs in all): Wine that
+    did not launch the program (scripts/wine_run.sh says more)."""
+    for attempt in range(3):
+        if os.path.exists(os.path.join(work, out)):
+            os.remove(os.path.join(work, out))  # a stale output must not pass for this run's
+        with tempfile.TemporaryFile("w+") as stderr:
+            try:
+                done = subprocess.run(command, cwd=work, env=env, stdin=subprocess.DEVNULL,
+                                      stdout=subprocess.DEVNULL, stderr=stderr, timeout=timeout)
+            except (OSError, subprocess.TimeoutExpired) as error:
+                print(f"[measure] {label}: FAILED: {error}\n    {shlex.join(command)}")
+                return None
+            stderr.seek(0)
+            message = stderr.read()
+        if done.returncode == 0 or message.strip() or os.path.exists(os.path.join(work, out)):
+            break
+        time.sleep(1 + attempt)
     if done.returncode != 0:
         why = (message.strip().splitlines() or ["(no message)"])[-1]
         print(f"[measure] {label}: FAILED: exit {done.returncode}: {why}\n    {shlex.join(command)}")
