@@ -20,7 +20,7 @@ A converged render's flicker is its own noise plus the resampling.
 
 prints per scene the RMSE against the reference (mean over the frames) and both flicker
 figures, for libssao (the default, and each --set variant given; with --layers also with the
-2nd and 3rd hits and a guard band, as the Blender node's defaults) and for Cycles; then, for a
+2nd to 4th hits and a guard band, as the Blender node's defaults) and for Cycles; then, for a
 box sliding over `contact`'s floor (the camera still), the error where the AO changed, with
 and without the temporal filter: a trail behind a moving object would show there. The renders
 are cached in the kit folder (about 25 min the first time on 2 cores); --update-docs puts the
@@ -173,6 +173,21 @@ def library_sequence(args, prefixes, settings):
                 for k in range(len(prefixes))]
 
 
+def hit_count(path):
+    """How many surface hits a layers file holds (its Depth, Depth2.Z, Depth3.Z, ...)."""
+    import OpenImageIO as oiio
+    image = oiio.ImageInput.open(path)
+    if image is None:
+        raise kit.StepFailed("cannot open %s: %s" % (path, oiio.geterror()))
+    names = list(image.spec().channelnames)
+    image.close()
+    count = 1
+    while any(n == "Depth%d.Z" % (count + 1) or n.endswith(".Depth%d.Z" % (count + 1))
+              for n in names):
+        count += 1
+    return count
+
+
 def merged_with_band(band_plane, frame_plane, band):
     """The layers file's plane (its band around the frame) with the frame's pixels taken from
     the reference render, as the Blender add-on gives them to the library."""
@@ -183,9 +198,9 @@ def merged_with_band(band_plane, frame_plane, band):
 
 
 def layered_sequence(args, blender_version, scene, prefixes):
-    """libssao's AO of every frame of a move with the 2nd and 3rd hits and a LAYERS_BAND px guard
-    band (what the Blender node's helper render adds by default: benchmark_layers.py on each
-    frame's camera), one ssao.Sequence from frame to frame as the node's animation renders.
+    """libssao's AO of every frame of a move with the hidden surface hits and a LAYERS_BAND px
+    guard band (what the Blender node's helper render adds by default: benchmark_layers.py on
+    each frame's camera), one ssao.Sequence from frame to frame as the node's animation renders.
     Hits not behind the depth the library is given are dropped and the later ones move up, as
     ssao_eval --layers does."""
     os.environ.setdefault("SSAO_LIBRARY", args.library)
@@ -200,14 +215,16 @@ def layered_sequence(args, blender_version, scene, prefixes):
                                 truck_px=k * STEP_PX)
         depth, nx, ny, nz = read_channels(prefix + ".exr",
                                           ["Depth.Z", "Normal.X", "Normal.Y", "Normal.Z"])
-        band_planes = read_channels(layers, ["Depth.Z", "Normal.X", "Normal.Y", "Normal.Z",
-                                             "Depth2.Z", "Facing2.V", "Depth3.Z", "Facing3.V"])
+        extra = hit_count(layers) - 1
+        band_planes = read_channels(layers, ["Depth.Z", "Normal.X", "Normal.Y", "Normal.Z"] + [
+            "%s%d.%s" % (name, k, axis) for k in range(2, extra + 2)
+            for name, axis in (("Depth", "Z"), ("Facing", "V"))])
         big_depth = merged_with_band(band_planes[0], depth, LAYERS_BAND)
         normals = np.stack([merged_with_band(b, f, LAYERS_BAND)
                             for b, f in zip(band_planes[1:4], (nx, ny, nz))], axis=-1)
         # Hits behind the depth, nearest first; the places left empty are "no hit".
-        hits = np.stack(band_planes[4:8:2], axis=-1)
-        facing = np.stack(band_planes[5:8:2], axis=-1)
+        hits = np.stack(band_planes[4::2], axis=-1)
+        facing = np.stack(band_planes[5::2], axis=-1)
         behind = hits > big_depth[:, :, None]
         order = np.argsort(np.where(behind, hits, np.inf), axis=-1, kind="stable")
         hits = np.take_along_axis(np.where(behind, hits, NO_HIT), order, axis=-1)
@@ -218,9 +235,9 @@ def layered_sequence(args, blender_version, scene, prefixes):
             np.ascontiguousarray(big_depth, dtype=np.float32), frame=k,
             normals=np.ascontiguousarray(normals, dtype=np.float32), camera=camera,
             depth_layers=[np.ascontiguousarray(hits[:, :, j], dtype=np.float32)
-                          for j in range(2)],
+                          for j in range(extra)],
             facing_layers=[np.ascontiguousarray(facing[:, :, j], dtype=np.float32)
-                           for j in range(2)],
+                           for j in range(extra)],
             output_window=(LAYERS_BAND, LAYERS_BAND, SIZE[0], SIZE[1]), radius=radius,
             threads=args.threads)
         aos.append(np.where(geometry(depth), ao, 1.0))
@@ -328,10 +345,10 @@ SECTION = "## Flicker on camera moves"
 
 LAYERS_TEXT = (
     "`libssao layers + %d px band`: with what the Blender node's helper render adds by default, "
-    "the 2nd and 3rd surface hits with their facing and a guard band, rendered for each frame's "
-    "camera at 1 spp (`scripts/blender/benchmark_layers.py --truck-px`), hits not behind the "
-    "frame's depth dropped as `ssao_eval --layers` does, one `ssao.Sequence` over the frames "
-    "as the node's animation renders." % LAYERS_BAND)
+    "the 2nd, 3rd and 4th surface hits with their facing and a guard band, rendered for each "
+    "frame's camera at 1 spp (`scripts/blender/benchmark_layers.py --truck-px`), hits not "
+    "behind the frame's depth dropped as `ssao_eval --layers` does, one `ssao.Sequence` over "
+    "the frames as the node's animation renders." % LAYERS_BAND)
 
 
 def section(rows, moving, command, machine):
@@ -391,7 +408,7 @@ def parse_args(argv=None):
     parser.add_argument("--set", action="append", default=[], metavar="NAME=VALUE[,NAME=VALUE]",
                         help="also measure libssao with these settings (repeatable)")
     parser.add_argument("--layers", action="store_true",
-                        help="also measure libssao with the 2nd and 3rd hits and a %d px guard "
+                        help="also measure libssao with the 2nd to 4th hits and a %d px guard "
                              "band, as the Blender node's defaults (renders them into the kit, "
                              "1 spp a frame)" % LAYERS_BAND)
     parser.add_argument("--library",

@@ -55,7 +55,7 @@ def main():
     parser.add_argument("--out", required=True)
     args = parser.parse_args(argv)
     scene = bpy.context.scene
-    hits, overscan = 3, 16
+    hits, overscan = hidden_surfaces.MAX_HITS, 16
     result = {}
 
     # A request replaced before it settles: only the second starts a process.
