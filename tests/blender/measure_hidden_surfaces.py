@@ -101,22 +101,28 @@ def measure(scene, label, args):
           f"{results[1, args.overscan]:.2f} s (Blender {bpy.app.version_string})", flush=True)
 
 
+def interleaved(timed_run, keys, rounds):
+    """{key: median seconds of timed_run(key)}: one warm-up each, then `rounds` rounds of every
+    key in turn (A B A B)."""
+    times = {key: [] for key in keys}
+    for key in keys:
+        timed_run(key)
+    for _ in range(rounds):
+        for key in keys:
+            times[key].append(timed_run(key))
+    return {key: statistics.median(values) for key, values in times.items()}
+
+
 def compare_hits(scene, label, args):
     """The helper render (no band) recording args.compare_hits[0] hits against [1], interleaved."""
-    times = {count: [] for count in args.compare_hits}
-
     def helper(count):
         hidden_surfaces.forget()
         start = time.perf_counter()
         hidden_surfaces.render_layers(scene, count, 0)
         return time.perf_counter() - start
 
-    for count in times:  # warm-up
-        helper(count)
-    for _ in range(args.rounds):
-        for count in times:
-            times[count].append(helper(count))
-    a, b = (statistics.median(times[c]) for c in args.compare_hits)
+    medians = interleaved(helper, args.compare_hits, args.rounds)
+    a, b = (medians[c] for c in args.compare_hits)
     print(f"[measure] {label}: helper {args.compare_hits[0]} hits {a:.3f} s, "
           f"{args.compare_hits[1]} hits {b:.3f} s (ratio {b / a:.3f}; medians of {args.rounds}, "
           f"interleaved; Blender {bpy.app.version_string})", flush=True)
@@ -124,7 +130,6 @@ def compare_hits(scene, label, args):
 
 def compare(scene, label, args, baseline):
     """The helper render (3 hits, no band) of this checkout against `baseline`'s, interleaved."""
-    times = {"baseline": [], "this": []}
     modules = {"baseline": baseline, "this": hidden_surfaces}
 
     def helper(name):
@@ -134,12 +139,8 @@ def compare(scene, label, args, baseline):
         modules[name].render_layers(scene, 3, 0)
         return time.perf_counter() - start
 
-    for name in modules:  # warm-up
-        helper(name)
-    for _ in range(args.rounds):
-        for name in modules:
-            times[name].append(helper(name))
-    base, this = (statistics.median(times[n]) for n in ("baseline", "this"))
+    medians = interleaved(helper, list(modules), args.rounds)
+    base, this = medians["baseline"], medians["this"]
     print(f"[measure] {label}: helper 3 hits, baseline {base:.3f} s, this {this:.3f} s "
           f"(ratio {this / base:.3f}; medians of {args.rounds}, interleaved; Blender "
           f"{bpy.app.version_string})", flush=True)
