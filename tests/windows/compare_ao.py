@@ -15,9 +15,10 @@ comparison; exit status 1 if any differs or any run fails.
     /usr/bin/python3 tests/windows/compare_ao.py --linux build/bin/raw_ao \
         --windows build-windows/bin/raw_ao.exe --sample tests/data --work /tmp/compare_ao
 
-wine runs with WINEDEBUG=-all and the caller's WINEPREFIX (~/.wine if not set), whose server
-scripts/start_wine.sh starts first; each run's output goes to a file, never a pipe that a Wine
-process started by the run could hold open (start_wine.sh says why).
+wine runs (through scripts/wine_run.sh, as the cross build's tests) with WINEDEBUG=-all and the
+caller's WINEPREFIX (~/.wine if not set), whose server scripts/start_wine.sh starts first; each
+run's output goes to a file, never a pipe that a Wine process started by the run could hold
+open (start_wine.sh says why).
 """
 import argparse
 import json
@@ -26,7 +27,6 @@ import shlex
 import subprocess
 import sys
 import tempfile
-import time
 
 import numpy as np
 import OpenImageIO as oiio
@@ -40,7 +40,10 @@ def parse_args():
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("--linux", required=True, help="raw_ao built for Linux")
     parser.add_argument("--windows", required=True, help="raw_ao.exe built with MinGW-w64")
-    parser.add_argument("--wine", default="wine", help="command that runs a Windows program")
+    parser.add_argument("--wine", default=os.path.join(ROOT, "scripts", "wine_run.sh"),
+                        help="command that runs a Windows program (default: wine through "
+                             "scripts/wine_run.sh, which runs it again when Wine did not launch "
+                             "it)")
     parser.add_argument("--sample", required=True, help="folder of sample.exr and its camera")
     parser.add_argument("--work", required=True, help="folder for the raw inputs and outputs")
     parser.add_argument("--variants", help="comma-separated variants (default: all)")
@@ -90,24 +93,18 @@ def as_argument(value):
 
 
 def run(label, command, work, out, pixels, timeout, env=None):
-    """Runs one raw_ao; returns the AO (float32, flat) or None after printing why it failed.
-    A run that failed without a word and wrote nothing is run again (3 runs in all): Wine that
-    did not launch the program (scripts/wine_run.sh says more)."""
-    for attempt in range(3):
-        if os.path.exists(os.path.join(work, out)):
-            os.remove(os.path.join(work, out))  # a stale output must not pass for this run's
-        with tempfile.TemporaryFile("w+") as stderr:
-            try:
-                done = subprocess.run(command, cwd=work, env=env, stdin=subprocess.DEVNULL,
-                                      stdout=subprocess.DEVNULL, stderr=stderr, timeout=timeout)
-            except (OSError, subprocess.TimeoutExpired) as error:
-                print(f"[measure] {label}: FAILED: {error}\n    {shlex.join(command)}")
-                return None
-            stderr.seek(0)
-            message = stderr.read()
-        if done.returncode == 0 or message.strip() or os.path.exists(os.path.join(work, out)):
-            break
-        time.sleep(1 + attempt)
+    """Runs one raw_ao; returns the AO (float32, flat) or None after printing why it failed."""
+    if os.path.exists(os.path.join(work, out)):
+        os.remove(os.path.join(work, out))  # a stale output must not pass for this run's
+    with tempfile.TemporaryFile("w+") as stderr:
+        try:
+            done = subprocess.run(command, cwd=work, env=env, stdin=subprocess.DEVNULL,
+                                  stdout=subprocess.DEVNULL, stderr=stderr, timeout=timeout)
+        except (OSError, subprocess.TimeoutExpired) as error:
+            print(f"[measure] {label}: FAILED: {error}\n    {shlex.join(command)}")
+            return None
+        stderr.seek(0)
+        message = stderr.read()
     if done.returncode != 0:
         why = (message.strip().splitlines() or ["(no message)"])[-1]
         print(f"[measure] {label}: FAILED: exit {done.returncode}: {why}\n    {shlex.join(command)}")
