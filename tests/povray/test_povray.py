@@ -32,7 +32,7 @@ import numpy as np
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
 from image_files import read_image  # noqa: E402
-from povray_process import run_povray  # noqa: E402
+from povray_process import STARTUP_TIMEOUT, run_povray  # noqa: E402
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 SCENES = os.path.join(HERE, "scenes")
@@ -1204,7 +1204,7 @@ count="{self.dir}/$(basename "$out").failures"
 n=$(cat "$count" 2>/dev/null || echo 0)
 if [ "$n" -lt {failures} ]; then
   echo $((n + 1)) > "$count"
-  echo "Timed out waiting for worker thread startup" >&2
+  echo "{STARTUP_TIMEOUT}" >&2
   exit 1
 fi
 exec {POVRAY} "$@"
@@ -1230,15 +1230,15 @@ exec {POVRAY} "$@"
         with open(os.path.join(keep, "depth.log")) as f:
             log = f.read()
         self.assertIn("run 3 of 4", log)
-        self.assertEqual(log.count("Timed out waiting for worker thread startup"), 2)
+        self.assertEqual(log.count(STARTUP_TIMEOUT), 2)
 
     def test_povray_that_never_starts_fails_clearly(self):
         scene = self.copy_scene("sphere_on_plane.pov")
         out, exr = self.path("out.png"), self.path("out.exr")
         proc = self.run_bridge(scene, "-o", out, "--exr", exr, "+W48", "+H36",
                                "--povray", self.busy_povray(99))
-        self.assert_fails(proc, "failed on the", "run 4 times",
-                          "Timed out waiting for worker thread startup", outputs=[out, exr])
+        self.assert_fails(proc, "failed on the", "run 4 times", STARTUP_TIMEOUT,
+                          outputs=[out, exr])
 
     def test_fisheye_camera(self):
         scene = self.copy_scene("fisheye.pov", """#version 3.7;
