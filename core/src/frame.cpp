@@ -58,6 +58,22 @@ float Frame::solid_entry(int x, int y, float depth, bool& closed, bool* past_las
 // distance (surfaces seen at an angle), and the match shows it as its visible surface with a
 // back face behind. The deepest of the four directions' matches counts, so that a thin
 // neighbour does not thin a thick solid.
+void Frame::measure_plane_distance_scale(TilePool& pool, Progress& progress) {
+  plane_distance_scale_.resize(extra_layers_ > 0 ? pixel_count() : 0);
+  if (extra_layers_ == 0) return;
+  pool.for_each_tile(width_, height_, progress, [&](const Tile& t) {
+    for (int y = t.y0; y < t.y1; ++y) {
+      for (int x = t.x0; x < t.x1; ++x) {
+        const Vec3 ray = camera_.orthographic()
+                             ? Vec3{0.0f, 0.0f, -1.0f}
+                             : camera_.view_position(float(x) + 0.5f, float(y) + 0.5f, 1.0f);
+        plane_distance_scale_[index(x, y)] =
+            is_geometry(x, y) ? std::fabs(dot(normal(x, y), ray)) : 0.0f;
+      }
+    }
+  });
+}
+
 void Frame::infer_last_thickness(TilePool& pool, Progress& progress) {
   last_thickness_.resize(extra_layers_ > 0 ? pixel_count() : 0);
   if (extra_layers_ == 0) return;
@@ -173,12 +189,14 @@ void Frame::build(const FrameInputs& in, TilePool& pool, Progress& progress) {
   fill_depth(in, pool, progress);
   build_normals(in, pool, progress);
   infer_last_thickness(pool, progress);
+  measure_plane_distance_scale(pool, progress);
 }
 
 void Frame::build_depth(const FrameInputs& in, TilePool& pool, Progress& progress) {
   fill_depth(in, pool, progress);
   std::vector<uint32_t>().swap(normal_);  // what a run at full resolution kept
   std::vector<float>().swap(last_thickness_);
+  std::vector<float>().swap(plane_distance_scale_);
 }
 
 void Frame::fill_depth(const FrameInputs& in, TilePool& pool, Progress& progress) {
@@ -402,6 +420,7 @@ void Frame::downsample(const Frame& full, const FrameInputs& in, TilePool& pool,
     }
   });
   infer_last_thickness(pool, progress);
+  measure_plane_distance_scale(pool, progress);
 }
 
 float background_limit(double background_depth, double clip_end) {

@@ -144,6 +144,16 @@ class Frame {
   }
   static constexpr int kThicknessSearch = 8;
 
+  // With extra layers, per pixel: how far from the visible surface's tangent plane a point on
+  // the pixel's ray lies per unit of planar depth it lies behind or in front of the surface
+  // (|normal . ray| with the ray's z = -1); 0 on background. Null without extra layers.
+  const float* plane_distance_scale_plane() const {
+    return extra_layers_ > 0 ? plane_distance_scale_.data() : nullptr;
+  }
+  float plane_distance_scale(int x, int y) const {
+    return extra_layers_ > 0 ? plane_distance_scale_[index(x, y)] : 0.0f;
+  }
+
  private:
   Vec3 reconstructed_normal(int x, int y) const;
   void fill_depth(const FrameInputs& in, TilePool& pool, Progress& progress);
@@ -164,6 +174,8 @@ class Frame {
 
   // Fills last_thickness_ from the finished depth and layer planes.
   void infer_last_thickness(TilePool& pool, Progress& progress);
+  // Fills plane_distance_scale_ from the finished depth and normal planes.
+  void measure_plane_distance_scale(TilePool& pool, Progress& progress);
   static void hidden_last_fronts(const float* layers, size_t plane, int extra_layers, int count,
                                  float* last);
   static bool search_step(const float* last, const float* visible, const float* layers,
@@ -182,6 +194,7 @@ class Frame {
   std::vector<uint32_t> normal_;
   std::vector<float> layers_;
   std::vector<float> last_thickness_;
+  std::vector<float> plane_distance_scale_;
 };
 
 }  // namespace ssao

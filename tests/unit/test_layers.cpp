@@ -53,6 +53,31 @@ Error error_against(const std::vector<float>& ao, const std::vector<double>& ref
   return e;
 }
 
+// Pixels a test scores and the ray-traced AO at each (about the pixel's own normal).
+struct Scored {
+  std::vector<size_t> pixels;
+  std::vector<double> reference;
+};
+
+// The geometry pixels of `s` at least `margin_x` / `margin_y` px inside the frame, every
+// `row_step`-th row, that `keep(point)` selects; `rays` rays each.
+template <class Keep>
+Scored score_where(const Scene& s, const std::vector<Solid>& solids, int rays, int margin_x,
+                   int margin_y, int row_step, Keep keep) {
+  Scored scored;
+  for (int y = margin_y; y < s.height - margin_y; y += row_step) {
+    for (int x = margin_x; x < s.width - margin_x; ++x) {
+      const size_t i = size_t(y) * s.width + x;
+      const V3 p = s.point[i];
+      if (!std::isfinite(s.depth[i]) || !keep(p)) continue;
+      scored.pixels.push_back(i);
+      const V3 normal{s.normal[3 * i], s.normal[3 * i + 1], s.normal[3 * i + 2]};
+      scored.reference.push_back(ray_traced_ao(solids, p, normal, kRadius, rays));
+    }
+  }
+  return scored;
+}
+
 // A floor seen from 30 degrees above, a sphere of radius 1 resting on it in the middle of the
 // view (in view space: the floor's normal tilted towards the camera).
 struct SphereOnFloor {
@@ -112,6 +137,60 @@ TEST(Layers, SphereOnAFloorOccludesTheFloorAsRayTraced) {
   EXPECT_LT(half.rmse, 0.8 * one.rmse);
 }
 
+TEST(Layers, TheSpheresUndersideShadesWithoutBands) {
+  // The sphere's own lower part, which the floor occludes more and more towards the contact. A
+  // direction is blocked once a step passes below the floor: with point samples each of the
+  // pattern's 64 directions (4 per pixel x 16 states) switched at once as the surface turned,
+  // and the AO fell in steps, bands along the sphere's parallels that denoising does not remove
+  // (the kit's `contact`, docs/variants.md). With the layers the samples are cones, which a
+  // surface covers gradually (Hemisphere::Cone).
+  Camera cam;
+  cam.width = 240, cam.height = 180, cam.lens = 80;  // the sphere 90 px across
+  const SphereOnFloor scene;
+  const auto solids = scene.solids();
+  Scene s = ray_cast(cam, solids);
+  const V3 center = scene.contact + scene.floor_normal * 1.0;
+  const Scored scored = score_where(s, solids, 256, 8, 8, 1, [&](const V3& p) {
+    return length(p - center) < 1.01 && dot(p - center, scene.floor_normal) < -0.3;
+  });
+  const std::vector<size_t>& pixels = scored.pixels;
+  const std::vector<double>& reference = scored.reference;
+  ASSERT_GT(pixels.size(), 400u);
+  // The bands run along the sphere's parallels, which cross the frame's rows near the bottom:
+  // the error's mean per row, less its mean over the 7 rows around, RMS over the rows.
+  const auto bands = [&](const std::vector<float>& ao) {
+    std::vector<double> sum(size_t(s.height), 0.0), count(size_t(s.height), 0.0);
+    for (size_t k = 0; k < pixels.size(); ++k) {
+      const size_t row = pixels[k] / size_t(s.width);
+      sum[row] += ao[pixels[k]] - reference[k], count[row] += 1;
+    }
+    double squared = 0;
+    int rows = 0;
+    for (int y = 3; y < s.height - 3; ++y) {
+      double around = 0;
+      bool full = true;
+      for (int d = -3; d <= 3; ++d) {
+        full = full && count[size_t(y + d)] >= 8;
+        if (full) around += sum[size_t(y + d)] / count[size_t(y + d)] / 7.0;
+      }
+      if (!full) continue;
+      const double residual = sum[size_t(y)] / count[size_t(y)] - around;
+      squared += residual * residual, ++rows;
+    }
+    return std::sqrt(squared / std::max(rows, 1));
+  };
+  const auto one = layered_ao(s, cam, false), three = layered_ao(s, cam, true);
+  const Error one_error = error_against(one, reference, pixels);
+  const Error three_error = error_against(three, reference, pixels);
+  std::printf(
+      "[ measure  ] sphere's underside, %zu px: one layer RMSE %.4f, bands %.4f; 3 hits RMSE "
+      "%.4f, bands %.4f (bands: the error's mean per row less its mean over 7 rows, RMS)\n",
+      pixels.size(), one_error.rmse, bands(one), three_error.rmse, bands(three));
+  // Measured with point samples: 3 hits RMSE 0.0394, bands 0.0050 (one layer 0.0592, 0.0050).
+  EXPECT_LT(three_error.rmse, 0.035);
+  EXPECT_LT(bands(three), 0.0045);
+}
+
 TEST(Layers, ThinPostCastsNoHaloOnTheWallBehindIt) {
   Camera cam;
   cam.width = 128, cam.height = 96;
@@ -153,22 +232,13 @@ TEST(Layers, ThinBoardOverAWallIsNoLighterWithLayers) {
       {{{0, 0, wall_z}, {0, 0, 1}}},
       box({-4, board_y, wall_z - 0.5}, {4, board_y + thickness, -1})};
   Scene s = ray_cast(cam, solids);
-  std::vector<size_t> pixels;
-  std::vector<double> reference;
-  for (int y = kBand + 4; y < s.height - kBand - 4; ++y) {
-    for (int x = kBand + 4; x < s.width - kBand - 4; ++x) {
-      const size_t i = size_t(y) * s.width + x;
-      const V3 p = s.point[i];
-      // The wall within 0.6 below the board.
-      if (!std::isfinite(s.depth[i]) || std::fabs(p.z - wall_z) > 1e-6 || p.y > board_y ||
-          p.y < board_y - 0.6) {
-        continue;
-      }
-      pixels.push_back(i);
-      // 1024 rays: the reference's own noise (0.014 RMS at AO 0.7) stays below the errors.
-      reference.push_back(ray_traced_ao(solids, p, {0, 0, 1}, kRadius, 1024));
-    }
-  }
+  // The wall within 0.6 below the board; 1024 rays: the reference's own noise (0.014 RMS at AO
+  // 0.7) stays below the errors.
+  const Scored scored = score_where(s, solids, 1024, kBand + 4, kBand + 4, 1, [&](const V3& p) {
+    return std::fabs(p.z - wall_z) < 1e-6 && p.y <= board_y && p.y >= board_y - 0.6;
+  });
+  const std::vector<size_t>& pixels = scored.pixels;
+  const std::vector<double>& reference = scored.reference;
   ASSERT_GT(pixels.size(), 500u);
   const Error one = error_against(layered_ao(s, cam, false), reference, pixels);
   const Error three = error_against(layered_ao(s, cam, true), reference, pixels);
@@ -184,11 +254,13 @@ TEST(Layers, ThinBoardOverAWallIsNoLighterWithLayers) {
       three_6.bias);
   EXPECT_LT(mean_reference, 0.8);  // the board occludes: the test measures something
   // Without the crossing test the layers read this wall far too light (RMSE 0.140, bias +0.121
-  // without the band). With it the board is seen; the crossing is caught once per direction, at
-  // the pair of steps around the board, and missed where the upper step's pixel shows the wall
-  // next to the board's underside (seen edge-on near the wall), so the layers stay a little
-  // lighter than one layer, whose thickness rule counts every step above the board.
-  EXPECT_LE(three.rmse, one.rmse + 0.012);
+  // without the band). With it the board is seen, once per direction, at the pair of steps
+  // around it; with point samples the layers stayed lighter than one layer (RMSE 0.0246, bias
+  // +0.015), the crossings missed where the upper step's pixel shows the wall beside the
+  // board's underside. As cones, samples just below the underside count in part: within 0.02 of
+  // ray-traced AO, and better than one layer (issue 31).
+  EXPECT_LT(three.rmse, 0.02);
+  EXPECT_LE(three.rmse, one.rmse);
   EXPECT_LT(std::fabs(three.bias), 0.02);
   EXPECT_LT(std::fabs(one.bias), 0.02);
 }
@@ -255,12 +327,13 @@ TEST(Layers, FacingTellsAnOpenSurfaceFromASolid) {
   const Stats faced = stats_over(s, ao(true, true), wall_beside_card);
   const Stats alternating = stats_over(s, ao(true, false), wall_beside_card);
   std::printf(
-      "[ measure  ] open card: wall beside it: one layer %.4f, facing given %.4f, "
-      "alternating %.4f\n",
+      "[ measure  ] open card: wall beside it: one layer %.5f, facing given %.5f, "
+      "alternating %.5f\n",
       one.mean, faced.mean, alternating.mean);
   // With its facing, a front-facing 2nd hit leaves the card to the thickness rule, as one layer
-  // does; taken as alternating, the gap up to the wall would be the inside of a solid.
-  EXPECT_NEAR(faced.mean, one.mean, 1e-6);
+  // does (the same up to the layered estimator's cones, measured 1e-5); taken as alternating,
+  // the gap up to the wall would be the inside of a solid.
+  EXPECT_NEAR(faced.mean, one.mean, 0.002);
   EXPECT_LT(alternating.mean, one.mean - 0.02);
 }
 
@@ -508,20 +581,11 @@ TEST(Layers, ColumnBehindAPostKeepsItsMeasuredThickness) {
   Scene with_post = ray_cast(cam, {wall, column, post});
   Scene without_post = ray_cast(cam, {wall, column});
   // The wall within 1 of the column's axis, seen in both frames.
-  std::vector<size_t> pixels;
-  std::vector<double> reference;
-  for (int y = 4; y < cam.height - 4; ++y) {
-    for (int x = 4; x < cam.width - 4; ++x) {
-      const size_t i = size_t(y) * cam.width + x;
-      const V3 p = with_post.point[i];
-      if (!std::isfinite(with_post.depth[i]) || std::fabs(p.z - wall_z) > 1e-6 ||
-          std::fabs(p.x) > 1.0) {
-        continue;
-      }
-      pixels.push_back(i);
-      reference.push_back(ray_traced_ao({wall, column}, p, {0, 0, 1}, kRadius, 512));
-    }
-  }
+  const Scored scored = score_where(with_post, {wall, column}, 512, 4, 4, 1, [&](const V3& p) {
+    return std::fabs(p.z - wall_z) < 1e-6 && std::fabs(p.x) <= 1.0;
+  });
+  const std::vector<size_t>& pixels = scored.pixels;
+  const std::vector<double>& reference = scored.reference;
   ASSERT_GT(pixels.size(), 5000u);
   const Error one = error_against(layered_ao(with_post, cam, false), reference, pixels);
   const Error three = error_against(layered_ao(with_post, cam, true), reference, pixels);

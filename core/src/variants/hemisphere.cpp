@@ -27,10 +27,11 @@
 
 namespace ssao {
 struct HemisphereRowArgs {
-  const float* depth;           // the frame's depth plane
-  const uint32_t* normals;      // the frame's packed normals
-  const float* layers;          // the frame's extra depth layers (Frame::layer_planes)
-  const float* last_thickness;  // Frame::last_thickness_plane
+  const float* depth;                 // the frame's depth plane
+  const uint32_t* normals;            // the frame's packed normals
+  const float* layers;                // the frame's extra depth layers (Frame::layer_planes)
+  const float* last_thickness;        // Frame::last_thickness_plane
+  const float* plane_distance_scale;  // Frame::plane_distance_scale_plane
   int extra_layers;
   int width, height;
   CameraIntrinsics camera;
@@ -40,6 +41,10 @@ struct HemisphereRowArgs {
   // Per row class (y & 3), per sample, x/y/z of the tangent-frame offset for kLaneTable lanes
   // starting at a pixel whose x is a multiple of 4.
   const float* lane_offsets;
+  // With extra layers, the same layout of each sample's cone (Hemisphere::Cone): 0.5 / its
+  // width, and how far the direction goes on past it for each unit from the step before.
+  const float* lane_cones;
+  float half_inv_end_width;  // 0.5 / the cone's width at the radius
 };
 }  // namespace ssao
 #endif
@@ -50,12 +55,13 @@ namespace HWY_NAMESPACE {
 namespace hn = hwy::HWY_NAMESPACE;
 
 // Hemisphere::crossing on the lanes of `candidate`, whose points a and b lie on either side of
-// the plane dot(x, c) = w: 1 where the depth image shows the plane, or something in front of
-// it, at the point where the segment meets the plane.
+// the plane dot(x, c) = w: where the depth image shows the plane, or something in front of it,
+// at the point where the segment meets the plane, the part of the direction's cone past the
+// plane at the radius (`extend`: the direction's length beyond b over b - a).
 template <class M, class VF>
 HWY_INLINE VF crossing_lanes(const HemisphereRowArgs& a, const LaneProjection<VF>& project,
                              M candidate, VF ax, VF ay, VF az, VF bx, VF by, VF bz, VF cx, VF cy,
-                             VF cz, VF w) {
+                             VF cz, VF w, VF extend) {
   namespace hn = hwy::HWY_NAMESPACE;
   const hn::DFromV<VF> df;
   const hn::RebindToSigned<decltype(df)> di;
@@ -93,7 +99,11 @@ HWY_INLINE VF crossing_lanes(const HemisphereRowArgs& a, const LaneProjection<VF
       hn::And(hn::And(lanes, hn::Gt(abs_slope, hn::Set(df, 1e-6f))),
               hn::Le(depth * abs_slope,
                      hn::MulAdd(hn::Set(df, a.crossing_tolerance), abs_slope, numerator * sign)));
-  return hn::IfThenElseZero(on_surface, one);
+  const VF past_end = hn::MulAdd(hn::Abs(side_a) + hn::Abs(side_b), extend, hn::Abs(side_b)) /
+                      hn::Sqrt(hn::MulAdd(cx, cx, hn::MulAdd(cy, cy, cz * cz)));
+  const VF half = hn::Set(df, 0.5f);
+  return hn::IfThenElseZero(
+      on_surface, hn::Min(one, hn::MulAdd(past_end, hn::Set(df, a.half_inv_end_width), half)));
 }
 
 // Visibility of pixels [x0, x1) of row y into out[0 .. x1 - x0); kLayers: the frame has extra
@@ -116,6 +126,9 @@ HWY_NOINLINE void hemisphere_row_of(const HemisphereRowArgs& a, int y, int x0, i
   // Vectors start at x0 + a multiple of `lanes` (itself a multiple of 4): one phase.
   const float* row_offsets =
       a.lane_offsets + size_t(y & 3) * a.directions * a.steps * 3 * kLaneTable + (x0 & 3);
+  const float* row_cones =
+      kLayers ? a.lane_cones + size_t(y & 3) * a.directions * a.steps * 2 * kLaneTable + (x0 & 3)
+              : nullptr;
   const VF view_y_of_row = project.center_v - hn::Set(df, float(y) + 0.5f);
 
   alignas(64) float depth_in[kMaxLanes];
@@ -164,6 +177,7 @@ HWY_NOINLINE void hemisphere_row_of(const HemisphereRowArgs& a, int y, int x0, i
     const VF plane_level = hn::MulAdd(px, nx, hn::MulAdd(py, ny, hn::MulAdd(pz, nz, min_height)));
     VF occlusion = zero, valid = zero;
     const float* offset = row_offsets;
+    [[maybe_unused]] const float* cone = row_cones;
     const auto none = hn::Lt(one, zero);  // all false
     for (int k = 0; k < a.directions; ++k) {
       VF blocked = zero;
@@ -175,6 +189,7 @@ HWY_NOINLINE void hemisphere_row_of(const HemisphereRowArgs& a, int y, int x0, i
       [[maybe_unused]] auto previous_hidden = none;
       [[maybe_unused]] VF pnx = zero, pny = zero, pnz = zero, pw = zero;
       const float* const direction_end = offset + size_t(a.steps) * 3 * kLaneTable;
+      [[maybe_unused]] const float* const cone_end = cone + size_t(a.steps) * 2 * kLaneTable;
       for (int step = 0; step < a.steps; ++step, offset += 3 * kLaneTable) {
         // A direction fully blocked on every lane stays so (it counts its strongest occluder,
         // and a weight is at most 1): its remaining steps cannot change the result.
@@ -208,6 +223,8 @@ HWY_NOINLINE void hemisphere_row_of(const HemisphereRowArgs& a, int y, int x0, i
         } else {
           const VI qx = hn::ConvertTo(di, hn::IfThenElseZero(in_image, su));
           const VI qy = hn::ConvertTo(di, hn::IfThenElseZero(in_image, sv));
+          const VF half_inv_width = hn::LoadU(df, cone), extend = hn::LoadU(df, cone + kLaneTable);
+          cone += 2 * kLaneTable;
           auto hidden = none;
           VF qxv = zero, qyv = zero, qzv = zero;
           VI index = hn::Zero(di);
@@ -221,7 +238,21 @@ HWY_NOINLINE void hemisphere_row_of(const HemisphereRowArgs& a, int y, int x0, i
             qxv = ray_x * q_scale, qyv = ray_y * q_scale;
             qzv = hn::Neg(qd);
             const VF behind = qzv - sz;  // > 0: the visible surface is in front of the sample
-            hidden = hn::And(hn::And(in_image, hn::Lt(qd, inf)), hn::Gt(behind, zero));
+            const auto surface = hn::And(in_image, hn::Lt(qd, inf));
+            hidden = hn::And(surface, hn::Gt(behind, zero));
+            // The part of the sample's cone behind the visible surface (Hemisphere::covered): a
+            // sample just in front of a surface above the tangent plane counts in part, one just
+            // behind it not yet fully.
+            // Only a surface above the tangent plane occludes, in front of the sample or not.
+            const auto above = hn::And(
+                surface, hn::Gt(hn::MulAdd(qxv, nx, hn::MulAdd(qyv, ny, qzv * nz)), plane_level));
+            VF covered = zero;
+            if (!hn::AllFalse(df, above)) {
+              const VF scale = hn::GatherIndex(df, a.plane_distance_scale, index);
+              covered =
+                  hn::Min(one, hn::Max(zero, hn::MulAdd(behind * scale, half_inv_width, half)));
+              blocked = hn::Max(blocked, hn::IfThenElseZero(hn::AndNot(hidden, above), covered));
+            }
             if (!hn::AllFalse(df, hidden)) {
               // Frame::solid_entry on the lanes: walk the hits behind the visible one until the
               // one the sample lies in front of.
@@ -266,7 +297,8 @@ HWY_NOINLINE void hemisphere_row_of(const HemisphereRowArgs& a, int y, int x0, i
                   hn::And(hn::And(hidden, entered), hn::Gt(entry_level, plane_level));
               const VF thick =
                   hn::Min(one, hn::Max(zero, two - (sample_depth - entry) * inv_depth_of_solid));
-              const VF weight = hn::IfThenElse(closed, one, thick);
+              const VF weight = hn::IfThenElse(hn::Eq(entry, qd), covered, one) *
+                                hn::IfThenElse(closed, one, thick);
               blocked = hn::Max(blocked, hn::IfThenElseZero(counts, weight));
             }
           }
@@ -296,7 +328,7 @@ HWY_NOINLINE void hemisphere_row_of(const HemisphereRowArgs& a, int y, int x0, i
                         hn::Lt(blocked, one));
             if (!hn::AllFalse(df, candidate)) {
               blocked = hn::Max(blocked, crossing_lanes(a, project, candidate, ax, ay, az, sx, sy,
-                                                        sz, cnx, cny, cnz, cw));
+                                                        sz, cnx, cny, cnz, cw, extend));
             }
           }
           ax = sx, ay = sy, az = sz;
@@ -305,6 +337,7 @@ HWY_NOINLINE void hemisphere_row_of(const HemisphereRowArgs& a, int y, int x0, i
         }
       }
       offset = direction_end;
+      if constexpr (kLayers) cone = cone_end;
       valid = valid + hn::IfThenElseZero(seen, one);
       occlusion = occlusion + hn::IfThenElseZero(seen, blocked);
     }
@@ -404,14 +437,29 @@ class Hemisphere final : public Variant {
       const Vec3 o = offsets_[size_t(jitter) * samples + s];
       return std::array<float, 3>{o.x, o.y, o.z};
     });
+    if (f.extra_layers() > 0) make_cones(samples);
   }
 
   void estimate(const Frame& f, const Tile& t, float* visibility) const override {
-    const HemisphereRowArgs args{
-        f.depth_plane(),  f.normal_plane(), f.layer_planes(), f.last_thickness_plane(),
-        f.extra_layers(), f.width(),        f.height(),       f.camera().intrinsics(),
-        radius_,          bias_ * radius_,  thickness_,       crossing_tolerance_,
-        f.pixel_count(),  directions_,      steps_,           lane_offsets_.data()};
+    const HemisphereRowArgs args{f.depth_plane(),
+                                 f.normal_plane(),
+                                 f.layer_planes(),
+                                 f.last_thickness_plane(),
+                                 f.plane_distance_scale_plane(),
+                                 f.extra_layers(),
+                                 f.width(),
+                                 f.height(),
+                                 f.camera().intrinsics(),
+                                 radius_,
+                                 bias_ * radius_,
+                                 thickness_,
+                                 crossing_tolerance_,
+                                 f.pixel_count(),
+                                 directions_,
+                                 steps_,
+                                 lane_offsets_.data(),
+                                 lane_cones_.data(),
+                                 half_inv_end_width_};
     for (int y = t.y0; y < t.y1; ++y) {
       best_hemisphere_row()(args, y, t.x0, t.x1, visibility + f.index(t.x0, y));
     }
@@ -422,6 +470,41 @@ class Hemisphere final : public Variant {
   }
 
  private:
+  // With extra layers a sample stands for the cone of directions around it that its share of
+  // the hemisphere covers: the 4x4 pattern gives directions x 16 directions to the pixels a
+  // denoised value averages, so a cone of half-angle sqrt(2 / (directions x 16)) each. A
+  // direction then turns blocked gradually as a surface moves across its cone, instead of at
+  // once where its point crosses the surface, which drew bands of equal AO across smooth
+  // surfaces under a large occluder (the floor below a sphere; docs/variants.md).
+  struct Cone {
+    float half_inv_width;  // 0.5 / the cone's width at the sample
+    float extend;          // the direction's length beyond the sample over the length from the step
+                           // before (the receiver for the first)
+  };
+  void make_cones(int samples) {
+    const float angle = std::sqrt(2.0f / float(directions_ * kJitterStates));
+    half_inv_end_width_ = 0.5f / (angle * radius_);
+    cones_.resize(offsets_.size());
+    for (size_t i = 0; i < offsets_.size(); ++i) {
+      const int step = int(i % size_t(steps_));
+      const float distance = length(offsets_[i]);
+      const float before = step > 0 ? length(offsets_[i - 1]) : 0.0f;
+      cones_[i] = {
+          0.5f / (angle * distance),
+          distance > before ? std::max(0.0f, radius_ - distance) / (distance - before) : 0.0f};
+    }
+    lane_cones_ = lane_table<2>(samples, [&](int jitter, int s) {
+      const Cone c = cones_[size_t(jitter) * samples + s];
+      return std::array<float, 2>{c.half_inv_width, c.extend};
+    });
+  }
+
+  // The part of a sample's cone behind the tangent plane of the visible surface q of its pixel
+  // (qx, qy): by how far the sample lies behind that plane (in front: < 0).
+  static float covered(const Frame& f, int qx, int qy, Vec3 sample, Vec3 q, const Cone& c) {
+    return saturate((q.z - sample.z) * f.plane_distance_scale(qx, qy) * c.half_inv_width + 0.5f);
+  }
+
   float pixel(const Frame& f, int x, int y) const {
     const Vec3 p = f.position(x, y);
     const Vec3 normal = f.normal(x, y);
@@ -430,6 +513,8 @@ class Hemisphere final : public Variant {
     Vec3 tangent, bitangent;
     orthonormal_basis(normal, tangent, bitangent);
     const Vec3* offset = offsets_.data() + size_t(jitter_index(x, y)) * directions_ * steps_;
+    const bool layered = f.extra_layers() > 0;
+    const Cone* cone = layered ? cones_.data() + (offset - offsets_.data()) : nullptr;
 
     // A direction counts as blocked by its strongest occluded sample, which is what Cycles'
     // binary ray visibility measures.
@@ -443,7 +528,7 @@ class Hemisphere final : public Variant {
       Vec3 previous = p;
       bool previous_hidden = false;
       Vec3 previous_surface{}, previous_normal{};
-      for (int step = 0; step < steps_; ++step, ++offset) {
+      for (int step = 0; step < steps_; ++step, ++offset, cone += layered ? 1 : 0) {
         const Vec3 sample = p + tangent * offset->x + bitangent * offset->y + normal * offset->z;
         int qx = -1, qy = -1;
         bool hidden = false;
@@ -453,6 +538,10 @@ class Hemisphere final : public Variant {
           if (f.is_geometry(qx, qy)) {
             surface = f.position(qx, qy);
             hidden = -sample.z > -surface.z;
+            const float part = layered ? covered(f, qx, qy, sample, surface, *cone) : 1.0f;
+            if (layered && !hidden && dot(surface - p, normal) > min_height) {
+              blocked = std::max(blocked, part);
+            }
             // The surface the sample lies behind (the visible one without extra layers), if any.
             bool closed = false, past_last = false;
             const float entry = f.solid_entry(qx, qy, -sample.z, closed, &past_last);
@@ -463,10 +552,11 @@ class Hemisphere final : public Variant {
               // plane.
               const float measured = past_last ? f.last_thickness(qx, qy) : 0.0f;
               if (dot(q - p, normal) > min_height) {
-                blocked = std::max(
-                    blocked, closed ? 1.0f
-                                    : thickness_weight(-sample.z - entry,
-                                                       measured > 0.0f ? measured : thickness_));
+                const float weight =
+                    closed ? 1.0f
+                           : thickness_weight(-sample.z - entry,
+                                              measured > 0.0f ? measured : thickness_);
+                blocked = std::max(blocked, entry == f.depth(qx, qy) ? part * weight : weight);
               }
             }
             // The crossing test (below) takes surfaces above the tangent plane only, as the
@@ -482,7 +572,7 @@ class Hemisphere final : public Variant {
           const bool here = hidden && sides_differ(previous, sample, surface, surface_normal);
           blocked =
               std::max(blocked, crossing(f, previous, sample, here ? surface : previous_surface,
-                                         here ? surface_normal : previous_normal));
+                                         here ? surface_normal : previous_normal, cone->extend));
         }
         previous = sample;
         previous_hidden = hidden;
@@ -500,12 +590,13 @@ class Hemisphere final : public Variant {
     return (dot(a - q, nq) > 0.0f) != (dot(b - q, nq) > 0.0f);
   }
 
-  // 1 when the segment from a to b passes through the visible surface of a pixel that one of
-  // them lies hidden behind: it goes from one side of that surface's tangent plane (point q,
-  // normal nq) to the other, and where it meets the plane the depth image shows that plane (or
-  // something in front of it), so the crossing point is on a surface, not in open air beside
-  // one.
-  float crossing(const Frame& f, Vec3 a, Vec3 b, Vec3 q, Vec3 nq) const {
+  // When the segment from a to b passes through the visible surface of a pixel that one of
+  // them lies hidden behind (it goes from one side of that surface's tangent plane, point q,
+  // normal nq, to the other, and where it meets the plane the depth image shows that plane or
+  // something in front of it, so the crossing point is on a surface, not in open air beside
+  // one): the part of the direction's cone past the plane at the radius, the direction going
+  // on beyond b by `extend` times b - a. Else 0.
+  float crossing(const Frame& f, Vec3 a, Vec3 b, Vec3 q, Vec3 nq, float extend) const {
     const float side_a = dot(a - q, nq), side_b = dot(b - q, nq);
     if ((side_a > 0.0f) == (side_b > 0.0f)) return 0.0f;
     const Vec3 c = a + (b - a) * (side_a / (side_a - side_b));
@@ -518,13 +609,20 @@ class Hemisphere final : public Variant {
     const float slope = dot(cam.view_position(u, v, 1.0f) - origin, nq);
     if (!(std::fabs(slope) > 1e-6f)) return 0.0f;
     const float plane_depth = dot(q - origin, nq) / slope;
-    return f.depth(cx, cy) <= plane_depth + crossing_tolerance_ ? 1.0f : 0.0f;
+    if (!(f.depth(cx, cy) <= plane_depth + crossing_tolerance_)) return 0.0f;
+    const float past_end = (std::fabs(side_a) + std::fabs(side_b)) * extend + std::fabs(side_b);
+    return std::min(1.0f, past_end / length(nq) * half_inv_end_width_ + 0.5f);
   }
 
   float radius_, bias_, thickness_, crossing_tolerance_;
   int directions_, steps_;
   std::vector<Vec3> offsets_;        // [jitter state][direction][step]
   std::vector<float> lane_offsets_;  // [y & 3][sample][x, y, z][lane]
+  // With extra layers: per offset its cone, and the same for the vector path ([y & 3][sample]
+  // [half_inv_width, extend][lane]).
+  std::vector<Cone> cones_;
+  std::vector<float> lane_cones_;
+  float half_inv_end_width_ = 0.0f;
 };
 
 }  // namespace
