@@ -102,14 +102,15 @@ def scene_columns(args, scene):
         return None
     reference = os.path.join(folder, "ref")
     with open(reference + ".json", encoding="utf-8") as f:
-        radius = json.load(f)["ao_distance"]
+        settings = json.load(f)
+    radius = settings["ao_distance"]
     layers_folder = find(os.path.join(args.kit, "%s@%s-layers-*" % (scene, args.size)))
     layers = os.path.join(layers_folder, "ref.layers.exr") if layers_folder else None
     truth = read_channel(reference + ".exr", "AO.R")
     depth = read_channel(reference + ".exr", "Depth.Z")
     geometry = np.isfinite(depth) & (depth > 0) & (depth < 1e9)
     truth = np.where(geometry, truth, 1.0)
-    columns = [("Cycles 1024 spp (reference)", truth)]
+    columns = [("Cycles %d spp (reference)" % settings["samples"], truth)]
     if args.baseline_lib:
         columns.append(("before: default",
                         library_ao(args, reference, radius, [], library_dir=args.baseline_lib)))
