@@ -189,7 +189,8 @@ HWY_NOINLINE void hemisphere_row_of(const HemisphereRowArgs& a, int y, int x0, i
       [[maybe_unused]] auto previous_hidden = none;
       [[maybe_unused]] VF pnx = zero, pny = zero, pnz = zero, pw = zero;
       const float* const direction_end = offset + size_t(a.steps) * 3 * kLaneTable;
-      [[maybe_unused]] const float* const cone_end = cone + size_t(a.steps) * 2 * kLaneTable;
+      [[maybe_unused]] const float* const cone_end =
+          kLayers ? cone + size_t(a.steps) * 2 * kLaneTable : nullptr;
       for (int step = 0; step < a.steps; ++step, offset += 3 * kLaneTable) {
         // A direction fully blocked on every lane stays so (it counts its strongest occluder,
         // and a weight is at most 1): its remaining steps cannot change the result.
