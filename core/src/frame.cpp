@@ -49,15 +49,6 @@ float Frame::solid_entry(int x, int y, float depth, bool& closed, bool* past_las
   return entered ? entry : kBackground;  // behind the last known hit
 }
 
-// A solid whose front face is the ray's last known hit, hidden behind the visible surface, has
-// its back beyond the layers; the thickness rule would make a 6 cm column behind a fence post
-// as deep as `thickness` (25 cm on the benchmark's `thin`). Where the same surface is visible
-// beside the foreground, its 2nd hit is its back face: that stretch is the thickness. "The same
-// surface": walking from the pixel along a row or column, every pixel up to the match (within
-// kThicknessSearch) has a hit at the hidden front's depth, within 1 % plus 0.5 % a pixel of
-// distance (surfaces seen at an angle), and the match shows it as its visible surface with a
-// back face behind. The deepest of the four directions' matches counts, so that a thin
-// neighbour does not thin a thick solid.
 void Frame::measure_plane_distance_scale(TilePool& pool, Progress& progress) {
   plane_distance_scale_.resize(extra_layers_ > 0 ? pixel_count() : 0);
   if (extra_layers_ == 0) return;
@@ -74,6 +65,15 @@ void Frame::measure_plane_distance_scale(TilePool& pool, Progress& progress) {
   });
 }
 
+// A solid whose front face is the ray's last known hit, hidden behind the visible surface, has
+// its back beyond the layers; the thickness rule would make a 6 cm column behind a fence post
+// as deep as `thickness` (25 cm on the benchmark's `thin`). Where the same surface is visible
+// beside the foreground, its 2nd hit is its back face: that stretch is the thickness. "The same
+// surface": walking from the pixel along a row or column, every pixel up to the match (within
+// kThicknessSearch) has a hit at the hidden front's depth, within 1 % plus 0.5 % a pixel of
+// distance (surfaces seen at an angle), and the match shows it as its visible surface with a
+// back face behind. The deepest of the four directions' matches counts, so that a thin
+// neighbour does not thin a thick solid.
 void Frame::infer_last_thickness(TilePool& pool, Progress& progress) {
   last_thickness_.resize(extra_layers_ > 0 ? pixel_count() : 0);
   if (extra_layers_ == 0) return;
