@@ -227,6 +227,7 @@ HWY_NOINLINE void hemisphere_row_of(const HemisphereRowArgs& a, int y, int x0, i
           const VF half_inv_width = hn::LoadU(df, cone), extend = hn::LoadU(df, cone + kLaneTable);
           cone += 2 * kLaneTable;
           auto hidden = none;
+          auto above = none;  // the visible surface lies above the tangent plane: it may occlude
           VF qxv = zero, qyv = zero, qzv = zero;
           VI index = hn::Zero(di);
           if (!hn::AllFalse(df, in_image)) {
@@ -241,12 +242,11 @@ HWY_NOINLINE void hemisphere_row_of(const HemisphereRowArgs& a, int y, int x0, i
             const VF behind = qzv - sz;  // > 0: the visible surface is in front of the sample
             const auto surface = hn::And(in_image, hn::Lt(qd, inf));
             hidden = hn::And(surface, hn::Gt(behind, zero));
+            above = hn::And(
+                surface, hn::Gt(hn::MulAdd(qxv, nx, hn::MulAdd(qyv, ny, qzv * nz)), plane_level));
             // The part of the sample's cone behind the visible surface (Hemisphere::covered): a
             // sample just in front of a surface above the tangent plane counts in part, one just
             // behind it not yet fully.
-            // Only a surface above the tangent plane occludes, in front of the sample or not.
-            const auto above = hn::And(
-                surface, hn::Gt(hn::MulAdd(qxv, nx, hn::MulAdd(qyv, ny, qzv * nz)), plane_level));
             VF covered = zero;
             if (!hn::AllFalse(df, above)) {
               const VF scale = hn::GatherIndex(df, a.plane_distance_scale, index);
@@ -307,8 +307,7 @@ HWY_NOINLINE void hemisphere_row_of(const HemisphereRowArgs& a, int y, int x0, i
           // surface that neither lies in (a 2 cm board between two steps): the plane of the
           // surface this sample is hidden behind, else the previous point's (Hemisphere::pixel);
           // surfaces above the tangent plane only.
-          hidden = hn::And(hn::And(hidden, hn::Lt(blocked, one)),
-                           hn::Gt(hn::MulAdd(qxv, nx, hn::MulAdd(qyv, ny, qzv * nz)), plane_level));
+          hidden = hn::And(hn::And(hidden, hn::Lt(blocked, one)), above);
           VF hnx = zero, hny = zero, hnz = zero, hw = zero;
           if (!hn::AllFalse(df, hn::Or(hidden, hn::And(previous_hidden, hn::Lt(blocked, one))))) {
             if (!hn::AllFalse(df, hidden)) {
@@ -539,8 +538,9 @@ class Hemisphere final : public Variant {
           if (f.is_geometry(qx, qy)) {
             surface = f.position(qx, qy);
             hidden = -sample.z > -surface.z;
+            const bool above = dot(surface - p, normal) > min_height;
             const float part = layered ? covered(f, qx, qy, sample, surface, *cone) : 1.0f;
-            if (layered && !hidden && dot(surface - p, normal) > min_height) {
+            if (layered && !hidden && above) {
               blocked = std::max(blocked, part);
             }
             // The surface the sample lies behind (the visible one without extra layers), if any.
@@ -562,7 +562,7 @@ class Hemisphere final : public Variant {
             }
             // The crossing test (below) takes surfaces above the tangent plane only, as the
             // test above.
-            hidden = hidden && dot(surface - p, normal) > min_height;
+            hidden = hidden && above;
             if (hidden) surface_normal = f.normal(qx, qy);
           }
         }
