@@ -54,30 +54,19 @@ namespace ssao {
 namespace HWY_NAMESPACE {
 namespace hn = hwy::HWY_NAMESPACE;
 
-// Hemisphere::crossing on the lanes of `candidate`, whose points a and b lie on either side of
-// the plane dot(x, c) = w: where the depth image shows the plane, or something in front of it,
-// at the point where the segment meets the plane, the part of the direction's cone past the
-// plane at the radius (`extend`: the direction's length beyond b over b - a).
+// Hemisphere::shows_plane on the lanes of `candidate`: where the depth image shows the plane
+// dot(x, c) = w, or something in front of it, at the pixel of point (px, py, pz).
 template <class M, class VF>
-HWY_INLINE VF crossing_lanes(const HemisphereRowArgs& a, const LaneProjection<VF>& project,
-                             M candidate, VF ax, VF ay, VF az, VF bx, VF by, VF bz, VF cx, VF cy,
-                             VF cz, VF w, VF extend) {
+HWY_INLINE M plane_shown_lanes(const HemisphereRowArgs& a, const LaneProjection<VF>& project,
+                               M candidate, VF px, VF py, VF pz, VF cx, VF cy, VF cz, VF w) {
   namespace hn = hwy::HWY_NAMESPACE;
   const hn::DFromV<VF> df;
   const hn::RebindToSigned<decltype(df)> di;
   const CameraIntrinsics& cam = a.camera;
-  const VF zero = hn::Zero(df), one = hn::Set(df, 1.0f);
-  const VF side_a = hn::MulAdd(ax, cx, hn::MulAdd(ay, cy, az * cz)) - w;
-  const VF side_b = hn::MulAdd(bx, cx, hn::MulAdd(by, cy, bz * cz)) - w;
-  // t = side_a / (side_a - side_b) in (0, 1]: a reciprocal estimate refined by a Newton step.
-  const VF span = hn::IfThenElse(candidate, side_a - side_b, one);
-  const VF estimate = hn::ApproximateReciprocal(span);
-  const VF t = side_a * (estimate * hn::NegMulAdd(span, estimate, hn::Set(df, 2.0f)));
-  const VF px = hn::MulAdd(bx - ax, t, ax), py = hn::MulAdd(by - ay, t, ay),
-           pz = hn::MulAdd(bz - az, t, az);
+  const VF one = hn::Set(df, 1.0f);
   VF cu, cv;
   const auto lanes = hn::And(candidate, project(px, py, pz, cu, cv));
-  if (hn::AllFalse(df, lanes)) return zero;
+  if (hn::AllFalse(df, lanes)) return lanes;
   const auto qx = hn::ConvertTo(di, hn::IfThenElseZero(lanes, cu));
   const auto qy = hn::ConvertTo(di, hn::IfThenElseZero(lanes, cv));
   // (qx, qy) are 0 on lanes outside the image: every index is in the plane.
@@ -95,15 +84,65 @@ HWY_INLINE VF crossing_lanes(const HemisphereRowArgs& a, const LaneProjection<VF
   }
   const VF sign = hn::CopySign(one, slope);
   const VF abs_slope = hn::Abs(slope);
-  const auto on_surface =
-      hn::And(hn::And(lanes, hn::Gt(abs_slope, hn::Set(df, 1e-6f))),
-              hn::Le(depth * abs_slope,
-                     hn::MulAdd(hn::Set(df, a.crossing_tolerance), abs_slope, numerator * sign)));
+  return hn::And(hn::And(lanes, hn::Gt(abs_slope, hn::Set(df, 1e-6f))),
+                 hn::Le(depth * abs_slope, hn::MulAdd(hn::Set(df, a.crossing_tolerance), abs_slope,
+                                                      numerator * sign)));
+}
+
+// Hemisphere::crossing on the lanes of `candidate`, whose points a and b lie on either side of
+// the plane dot(x, c) = w: where the depth image shows the plane, or something in front of it,
+// at the point where the segment meets the plane, the part of the direction's cone past the
+// plane at the radius (`extend`: the direction's length beyond b over b - a).
+template <class M, class VF>
+HWY_INLINE VF crossing_lanes(const HemisphereRowArgs& a, const LaneProjection<VF>& project,
+                             M candidate, VF ax, VF ay, VF az, VF bx, VF by, VF bz, VF cx, VF cy,
+                             VF cz, VF w, VF extend) {
+  namespace hn = hwy::HWY_NAMESPACE;
+  const hn::DFromV<VF> df;
+  const VF zero = hn::Zero(df), one = hn::Set(df, 1.0f);
+  const VF side_a = hn::MulAdd(ax, cx, hn::MulAdd(ay, cy, az * cz)) - w;
+  const VF side_b = hn::MulAdd(bx, cx, hn::MulAdd(by, cy, bz * cz)) - w;
+  // t = side_a / (side_a - side_b) in (0, 1]: a reciprocal estimate refined by a Newton step.
+  const VF span = hn::IfThenElse(candidate, side_a - side_b, one);
+  const VF estimate = hn::ApproximateReciprocal(span);
+  const VF t = side_a * (estimate * hn::NegMulAdd(span, estimate, hn::Set(df, 2.0f)));
+  const VF px = hn::MulAdd(bx - ax, t, ax), py = hn::MulAdd(by - ay, t, ay),
+           pz = hn::MulAdd(bz - az, t, az);
+  const auto on_surface = plane_shown_lanes(a, project, candidate, px, py, pz, cx, cy, cz, w);
+  if (hn::AllFalse(df, on_surface)) return zero;
   const VF past_end = hn::MulAdd(hn::Abs(side_a) + hn::Abs(side_b), extend, hn::Abs(side_b)) /
                       hn::Sqrt(hn::MulAdd(cx, cx, hn::MulAdd(cy, cy, cz * cz)));
   const VF half = hn::Set(df, 0.5f);
   return hn::IfThenElseZero(
       on_surface, hn::Min(one, hn::MulAdd(past_end, hn::Set(df, a.half_inv_end_width), half)));
+}
+
+// Hemisphere::reach on the lanes of `candidate`: the last sample b lies in front of the plane
+// dot(x, c) = w of the surface its pixel shows, and the direction goes on past b by `extend`
+// times b - a to the radius: the part of the cone's end past that plane, where the depth image
+// shows the plane at the point where the direction meets it (or at its end, if short of it).
+template <class M, class VF>
+HWY_INLINE VF reach_lanes(const HemisphereRowArgs& a, const LaneProjection<VF>& project,
+                          M candidate, VF ax, VF ay, VF az, VF bx, VF by, VF bz, VF cx, VF cy,
+                          VF cz, VF w, VF extend) {
+  namespace hn = hwy::HWY_NAMESPACE;
+  const hn::DFromV<VF> df;
+  const VF zero = hn::Zero(df), one = hn::Set(df, 1.0f), half = hn::Set(df, 0.5f);
+  const VF ex = hn::MulAdd(bx - ax, extend, bx), ey = hn::MulAdd(by - ay, extend, by),
+           ez = hn::MulAdd(bz - az, extend, bz);
+  const VF side_b = hn::MulAdd(bx, cx, hn::MulAdd(by, cy, bz * cz)) - w;
+  const VF side_e = hn::MulAdd(ex, cx, hn::MulAdd(ey, cy, ez * cz)) - w;
+  const VF inv_length = one / hn::Sqrt(hn::MulAdd(cx, cx, hn::MulAdd(cy, cy, cz * cz)));
+  const VF part = hn::NegMulAdd(side_e * inv_length, hn::Set(df, a.half_inv_end_width), half);
+  const auto lanes = hn::And(candidate, hn::And(hn::Gt(side_b, zero), hn::Gt(part, zero)));
+  if (hn::AllFalse(df, lanes)) return zero;
+  const auto short_of = hn::Ge(side_e, zero);
+  const VF t =
+      hn::IfThenElse(short_of, one, side_b / hn::IfThenElse(short_of, one, side_b - side_e));
+  const VF px = hn::MulAdd(ex - bx, t, bx), py = hn::MulAdd(ey - by, t, by),
+           pz = hn::MulAdd(ez - bz, t, bz);
+  const auto on_surface = plane_shown_lanes(a, project, lanes, px, py, pz, cx, cy, cz, w);
+  return hn::IfThenElseZero(on_surface, hn::Min(one, part));
 }
 
 // Visibility of pixels [x0, x1) of row y into out[0 .. x1 - x0); kLayers: the frame has extra
@@ -306,11 +345,15 @@ HWY_NOINLINE void hemisphere_row_of(const HemisphereRowArgs& a, int y, int x0, i
           // Between the previous point and this one the direction may have passed through a
           // surface that neither lies in (a 2 cm board between two steps): the plane of the
           // surface this sample is hidden behind, else the previous point's (Hemisphere::pixel);
-          // surfaces above the tangent plane only.
+          // surfaces above the tangent plane only. The last sample in front of such a surface:
+          // the direction may reach it beyond (Hemisphere::reach).
+          const auto ends =
+              step == a.steps - 1 ? hn::And(hn::AndNot(hidden, above), hn::Lt(blocked, one)) : none;
           hidden = hn::And(hn::And(hidden, hn::Lt(blocked, one)), above);
+          const auto planes = hn::Or(hidden, ends);
           VF hnx = zero, hny = zero, hnz = zero, hw = zero;
-          if (!hn::AllFalse(df, hn::Or(hidden, hn::And(previous_hidden, hn::Lt(blocked, one))))) {
-            if (!hn::AllFalse(df, hidden)) {
+          if (!hn::AllFalse(df, hn::Or(planes, hn::And(previous_hidden, hn::Lt(blocked, one))))) {
+            if (!hn::AllFalse(df, planes)) {
               const VI packed =
                   hn::GatherIndex(di, reinterpret_cast<const int32_t*>(a.normals), index);
               decode_directions(df, packed, hnx, hny, hnz);  // sides of a plane: any length
@@ -330,6 +373,10 @@ HWY_NOINLINE void hemisphere_row_of(const HemisphereRowArgs& a, int y, int x0, i
               blocked = hn::Max(blocked, crossing_lanes(a, project, candidate, ax, ay, az, sx, sy,
                                                         sz, cnx, cny, cnz, cw, extend));
             }
+          }
+          if (!hn::AllFalse(df, ends)) {
+            blocked = hn::Max(blocked, reach_lanes(a, project, ends, ax, ay, az, sx, sy, sz, hnx,
+                                                   hny, hnz, hw, extend));
           }
           ax = sx, ay = sy, az = sz;
           previous_hidden = hidden;
@@ -531,14 +578,14 @@ class Hemisphere final : public Variant {
       for (int step = 0; step < steps_; ++step, ++offset, cone += layered ? 1 : 0) {
         const Vec3 sample = p + tangent * offset->x + bitangent * offset->y + normal * offset->z;
         int qx = -1, qy = -1;
-        bool hidden = false;
+        bool hidden = false, above = false;
         Vec3 surface{}, surface_normal{};
         if (pixel_of_sample(f, sample, qx, qy)) {
           seen = true;
           if (f.is_geometry(qx, qy)) {
             surface = f.position(qx, qy);
             hidden = -sample.z > -surface.z;
-            const bool above = dot(surface - p, normal) > min_height;
+            above = dot(surface - p, normal) > min_height;
             const float part = layered ? covered(f, qx, qy, sample, surface, *cone) : 1.0f;
             if (layered && !hidden && above) {
               blocked = std::max(blocked, part);
@@ -560,12 +607,15 @@ class Hemisphere final : public Variant {
                 blocked = std::max(blocked, entry == f.depth(qx, qy) ? part * weight : weight);
               }
             }
-            // The crossing test (below) takes surfaces above the tangent plane only, as the
-            // test above.
-            hidden = hidden && above;
-            if (hidden) surface_normal = f.normal(qx, qy);
           }
         }
+        // The last sample in front of a surface above the tangent plane: the direction goes on
+        // to the radius, and may reach that surface beyond it.
+        const bool ends = layered && step == steps_ - 1 && above && !hidden;
+        // The crossing test (below) takes surfaces above the tangent plane only, as the test
+        // above.
+        hidden = hidden && above;
+        if (hidden || ends) surface_normal = f.normal(qx, qy);
         // Between the two points the direction may have passed through a surface that neither
         // point lies in (a 2 cm board between two steps): the plane of the surface this sample
         // is hidden behind, else that of the one the previous point was hidden behind.
@@ -574,6 +624,10 @@ class Hemisphere final : public Variant {
           blocked =
               std::max(blocked, crossing(f, previous, sample, here ? surface : previous_surface,
                                          here ? surface_normal : previous_normal, cone->extend));
+        }
+        if (ends && blocked < 1.0f) {
+          blocked =
+              std::max(blocked, reach(f, previous, sample, surface, surface_normal, cone->extend));
         }
         previous = sample;
         previous_hidden = hidden;
@@ -601,18 +655,38 @@ class Hemisphere final : public Variant {
     const float side_a = dot(a - q, nq), side_b = dot(b - q, nq);
     if ((side_a > 0.0f) == (side_b > 0.0f)) return 0.0f;
     const Vec3 c = a + (b - a) * (side_a / (side_a - side_b));
+    if (!shows_plane(f, c, q, nq)) return 0.0f;
+    const float past_end = (std::fabs(side_a) + std::fabs(side_b)) * extend + std::fabs(side_b);
+    return std::min(1.0f, past_end / length(nq) * half_inv_end_width_ + 0.5f);
+  }
+
+  // When the last sample b of a direction (the one before: a) lies in front of the tangent
+  // plane (point q, normal nq) of the surface its pixel shows, and the direction goes on beyond
+  // b by `extend` times b - a to the radius: the part of the cone's end past that plane (half
+  // where the end lies on it, none half a cone's width short of it), if the depth image shows
+  // the plane where the direction meets it (at its end, when short of it). Else 0.
+  float reach(const Frame& f, Vec3 a, Vec3 b, Vec3 q, Vec3 nq, float extend) const {
+    const Vec3 end = b + (b - a) * extend;
+    const float side_b = dot(b - q, nq), side_end = dot(end - q, nq);
+    const float part = 0.5f - side_end / length(nq) * half_inv_end_width_;
+    if (!(side_b > 0.0f) || !(part > 0.0f)) return 0.0f;
+    const Vec3 c = side_end >= 0.0f ? end : b + (end - b) * (side_b / (side_b - side_end));
+    return shows_plane(f, c, q, nq) ? std::min(1.0f, part) : 0.0f;
+  }
+
+  // Whether the depth image, at the pixel of point c (on the plane through q with normal nq),
+  // shows that plane or something in front of it.
+  bool shows_plane(const Frame& f, Vec3 c, Vec3 q, Vec3 nq) const {
     int cx, cy;
-    if (!pixel_of_sample(f, c, cx, cy) || !f.is_geometry(cx, cy)) return 0.0f;
+    if (!pixel_of_sample(f, c, cx, cy) || !f.is_geometry(cx, cy)) return false;
     // The plane's depth on the ray through that pixel's centre.
     const CameraModel& cam = f.camera();
     const float u = float(cx) + 0.5f, v = float(cy) + 0.5f;
     const Vec3 origin = cam.view_position(u, v, 0.0f);
     const float slope = dot(cam.view_position(u, v, 1.0f) - origin, nq);
-    if (!(std::fabs(slope) > 1e-6f)) return 0.0f;
+    if (!(std::fabs(slope) > 1e-6f)) return false;
     const float plane_depth = dot(q - origin, nq) / slope;
-    if (!(f.depth(cx, cy) <= plane_depth + crossing_tolerance_)) return 0.0f;
-    const float past_end = (std::fabs(side_a) + std::fabs(side_b)) * extend + std::fabs(side_b);
-    return std::min(1.0f, past_end / length(nq) * half_inv_end_width_ + 0.5f);
+    return f.depth(cx, cy) <= plane_depth + crossing_tolerance_;
   }
 
   float radius_, bias_, thickness_, crossing_tolerance_;
