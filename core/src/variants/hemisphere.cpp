@@ -145,6 +145,55 @@ HWY_INLINE VF reach_lanes(const HemisphereRowArgs& a, const LaneProjection<VF>& 
   return hn::IfThenElseZero(on_surface, hn::Min(one, part));
 }
 
+// Hemisphere::between on the lanes of `candidate`: point (mx, my, mz), halfway between two
+// steps of a direction, lies behind the visible surface of its pixel and in front of the ray's
+// next hit, and that surface is above the receiver's tangent plane (normal n, level
+// `plane_level`): the part of the sample's cone behind it, times the solid's weight (1 where
+// the next hit is a back face, else by the assumed thickness).
+template <class M, class VF>
+HWY_INLINE VF between_lanes(const HemisphereRowArgs& a, const LaneProjection<VF>& project,
+                            M candidate, VF mx, VF my, VF mz, VF ex, VF ey, VF ez, VF nx, VF ny,
+                            VF nz, VF plane_level, VF half_inv_width) {
+  namespace hn = hwy::HWY_NAMESPACE;
+  const hn::DFromV<VF> df;
+  const hn::RebindToSigned<decltype(df)> di;
+  const VF zero = hn::Zero(df), one = hn::Set(df, 1.0f), half = hn::Set(df, 0.5f);
+  VF mu, mv;
+  const auto lanes = hn::And(candidate, project(mx, my, mz, mu, mv));
+  if (hn::AllFalse(df, lanes)) return zero;
+  const auto qx = hn::ConvertTo(di, hn::IfThenElseZero(lanes, mu));
+  const auto qy = hn::ConvertTo(di, hn::IfThenElseZero(lanes, mv));
+  const auto index = qy * hn::Set(di, a.width) + qx;
+  const VF qd = hn::GatherIndex(df, a.depth, index);
+  const VF behind = hn::Neg(mz) - qd;  // > 0: the visible surface is in front of the point
+  VF ray_x, ray_y;
+  project.pixel_ray(qx, qy, ray_x, ray_y);
+  const VF q_scale = a.camera.orthographic ? one : qd;
+  const auto hidden = hn::And(
+      hn::And(lanes, hn::Lt(qd, hn::Set(df, std::numeric_limits<float>::infinity()))),
+      hn::And(
+          hn::Gt(behind, zero),
+          hn::Gt(hn::MulAdd(ray_x * q_scale, nx, hn::MulAdd(ray_y * q_scale, ny, hn::Neg(qd) * nz)),
+                 plane_level)));
+  if (hn::AllFalse(df, hidden)) return zero;
+  const VF next = hn::GatherIndex(df, a.layers, index);
+  const auto inside = hn::And(hidden, hn::Le(hn::Neg(mz), hn::Abs(next)));
+  if (hn::AllFalse(df, inside)) return zero;
+  const VF scale = hn::GatherIndex(df, a.plane_distance_scale, index);
+  VF cx, cy, cz;
+  decode_directions(df, hn::GatherIndex(di, reinterpret_cast<const int32_t*>(a.normals), index), cx,
+                    cy, cz);
+  const VF qxv = ray_x * q_scale, qyv = ray_y * q_scale, qzv = hn::Neg(qd);
+  const VF side_e = hn::MulAdd(ex - qxv, cx, hn::MulAdd(ey - qyv, cy, (ez - qzv) * cz));
+  const VF past_end = hn::Neg(side_e) / hn::Sqrt(hn::MulAdd(cx, cx, hn::MulAdd(cy, cy, cz * cz)));
+  const VF covered = hn::Min(
+      one, hn::Max(zero, hn::Max(hn::MulAdd(behind * scale, half_inv_width, half),
+                                 hn::MulAdd(past_end, hn::Set(df, a.half_inv_end_width), half))));
+  const VF thick = hn::Min(one, hn::Max(zero, hn::NegMulAdd(behind, hn::Set(df, 1.0f / a.thickness),
+                                                            hn::Set(df, 2.0f))));
+  return hn::IfThenElseZero(inside, covered * hn::IfThenElse(hn::Lt(next, zero), one, thick));
+}
+
 // Visibility of pixels [x0, x1) of row y into out[0 .. x1 - x0); kLayers: the frame has extra
 // depth layers (compiled apart, so that the one-layer loop carries none of their state).
 template <bool kLayers>
@@ -265,6 +314,16 @@ HWY_NOINLINE void hemisphere_row_of(const HemisphereRowArgs& a, int y, int x0, i
           const VI qy = hn::ConvertTo(di, hn::IfThenElseZero(in_image, sv));
           const VF half_inv_width = hn::LoadU(df, cone), extend = hn::LoadU(df, cone + kLaneTable);
           cone += 2 * kLaneTable;
+          // Halfway from the previous point (Hemisphere::between).
+          const auto open_lanes = hn::And(receiver, hn::Lt(blocked, one));
+          if (!hn::AllFalse(df, open_lanes)) {
+            blocked = hn::Max(
+                blocked,
+                between_lanes(a, project, open_lanes, (ax + sx) * half, (ay + sy) * half,
+                              (az + sz) * half, hn::MulAdd(sx - ax, extend, sx),
+                              hn::MulAdd(sy - ay, extend, sy), hn::MulAdd(sz - az, extend, sz), nx,
+                              ny, nz, plane_level, half_inv_width));
+          }
           auto hidden = none;
           auto above = none;  // the visible surface lies above the tangent plane: it may occlude
           VF qxv = zero, qyv = zero, qzv = zero;
@@ -577,6 +636,11 @@ class Hemisphere final : public Variant {
       Vec3 previous_surface{}, previous_normal{};
       for (int step = 0; step < steps_; ++step, ++offset, cone += layered ? 1 : 0) {
         const Vec3 sample = p + tangent * offset->x + bitangent * offset->y + normal * offset->z;
+        if (layered && blocked < 1.0f) {
+          blocked = std::max(
+              blocked, between(f, p, normal, min_height, (previous + sample) * 0.5f,
+                               sample + (sample - previous) * cone->extend, cone->half_inv_width));
+        }
         int qx = -1, qy = -1;
         bool hidden = false, above = false;
         Vec3 surface{}, surface_normal{};
@@ -658,6 +722,31 @@ class Hemisphere final : public Variant {
     if (!shows_plane(f, c, q, nq)) return 0.0f;
     const float past_end = (std::fabs(side_a) + std::fabs(side_b)) * extend + std::fabs(side_b);
     return std::min(1.0f, past_end / length(nq) * half_inv_end_width_ + 0.5f);
+  }
+
+  // A point halfway between two steps of a direction (a 2 cm board seen edge-on is a pixel or
+  // two wide on screen and falls between steps that lie several pixels apart): when it lies
+  // behind the visible surface of its pixel, in front of the ray's next hit, and that surface is
+  // above the receiver's tangent plane (p, normal, min_height), the part of the sample's cone
+  // behind the surface times the solid's weight: 1 when the next hit is a back face that closes
+  // it, else by the assumed thickness. Cheaper than a step: no deeper hits, no crossing test.
+  float between(const Frame& f, Vec3 p, Vec3 normal, float min_height, Vec3 point, Vec3 end,
+                float half_inv_width) const {
+    int qx, qy;
+    if (!pixel_of_sample(f, point, qx, qy) || !f.is_geometry(qx, qy)) return 0.0f;
+    const float behind = -point.z - f.depth(qx, qy);
+    if (!(behind > 0.0f) || !(dot(f.position(qx, qy) - p, normal) > min_height)) return 0.0f;
+    const float next = f.layer_planes()[f.index(qx, qy)];  // the ray's 2nd hit
+    if (!(-point.z <= std::fabs(next))) return 0.0f;
+    const float weight = next < 0.0f ? 1.0f : thickness_weight(behind, thickness_);
+    // The direction goes on to `end`: the part of its cone there past the surface's tangent
+    // plane, if more (a board the direction pierces blocks the whole cone, however thin).
+    const Vec3 nq = f.normal(qx, qy);
+    const float past_end = -dot(end - f.position(qx, qy), nq) / length(nq);
+    return saturate(std::max(behind * f.plane_distance_scale(qx, qy) * half_inv_width,
+                             past_end * half_inv_end_width_) +
+                    0.5f) *
+           weight;
   }
 
   // When the last sample b of a direction (the one before: a) lies in front of the tangent
