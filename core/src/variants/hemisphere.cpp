@@ -215,7 +215,7 @@ HWY_NOINLINE void hemisphere_row_of(const HemisphereRowArgs& a, int y, int x0, i
   const float* row_offsets =
       a.lane_offsets + size_t(y & 3) * a.directions * a.steps * 3 * kLaneTable + (x0 & 3);
   const float* row_cones =
-      kLayers ? a.lane_cones + size_t(y & 3) * a.directions * a.steps * 2 * kLaneTable + (x0 & 3)
+      kLayers ? a.lane_cones + size_t(y & 3) * a.directions * a.steps * 3 * kLaneTable + (x0 & 3)
               : nullptr;
   const VF view_y_of_row = project.center_v - hn::Set(df, float(y) + 0.5f);
 
@@ -278,7 +278,7 @@ HWY_NOINLINE void hemisphere_row_of(const HemisphereRowArgs& a, int y, int x0, i
       [[maybe_unused]] VF pnx = zero, pny = zero, pnz = zero, pw = zero;
       const float* const direction_end = offset + size_t(a.steps) * 3 * kLaneTable;
       [[maybe_unused]] const float* const cone_end =
-          kLayers ? cone + size_t(a.steps) * 2 * kLaneTable : nullptr;
+          kLayers ? cone + size_t(a.steps) * 3 * kLaneTable : nullptr;
       for (int step = 0; step < a.steps; ++step, offset += 3 * kLaneTable) {
         // A direction fully blocked on every lane stays so (it counts its strongest occluder,
         // and a weight is at most 1): its remaining steps cannot change the result.
@@ -313,7 +313,8 @@ HWY_NOINLINE void hemisphere_row_of(const HemisphereRowArgs& a, int y, int x0, i
           const VI qx = hn::ConvertTo(di, hn::IfThenElseZero(in_image, su));
           const VI qy = hn::ConvertTo(di, hn::IfThenElseZero(in_image, sv));
           const VF half_inv_width = hn::LoadU(df, cone), extend = hn::LoadU(df, cone + kLaneTable);
-          cone += 2 * kLaneTable;
+          const VF half_inv_width_between = hn::LoadU(df, cone + 2 * kLaneTable);
+          cone += 3 * kLaneTable;
           // Halfway from the previous point (Hemisphere::between).
           const auto open_lanes = hn::And(receiver, hn::Lt(blocked, one));
           if (!hn::AllFalse(df, open_lanes)) {
@@ -322,7 +323,7 @@ HWY_NOINLINE void hemisphere_row_of(const HemisphereRowArgs& a, int y, int x0, i
                 between_lanes(a, project, open_lanes, (ax + sx) * half, (ay + sy) * half,
                               (az + sz) * half, hn::MulAdd(sx - ax, extend, sx),
                               hn::MulAdd(sy - ay, extend, sy), hn::MulAdd(sz - az, extend, sz), nx,
-                              ny, nz, plane_level, half_inv_width));
+                              ny, nz, plane_level, half_inv_width_between));
           }
           auto hidden = none;
           auto above = none;  // the visible surface lies above the tangent plane: it may occlude
@@ -586,6 +587,7 @@ class Hemisphere final : public Variant {
     float half_inv_width;  // 0.5 / the cone's width at the sample
     float extend;          // the direction's length beyond the sample over the length from the step
                            // before (the receiver for the first)
+    float half_inv_width_between;  // the same at the point halfway from the step before
   };
   void make_cones(int samples) {
     const float angle = std::sqrt(2.0f / float(directions_ * kJitterStates));
@@ -595,13 +597,15 @@ class Hemisphere final : public Variant {
       const int step = int(i % size_t(steps_));
       const float distance = length(offsets_[i]);
       const float before = step > 0 ? length(offsets_[i - 1]) : 0.0f;
+      const Vec3 halfway = (offsets_[i] + (step > 0 ? offsets_[i - 1] : Vec3{})) * 0.5f;
       cones_[i] = {
           0.5f / (angle * distance),
-          distance > before ? std::max(0.0f, radius_ - distance) / (distance - before) : 0.0f};
+          distance > before ? std::max(0.0f, radius_ - distance) / (distance - before) : 0.0f,
+          0.5f / (angle * length(halfway))};
     }
-    lane_cones_ = lane_table<2>(samples, [&](int jitter, int s) {
+    lane_cones_ = lane_table<3>(samples, [&](int jitter, int s) {
       const Cone c = cones_[size_t(jitter) * samples + s];
-      return std::array<float, 2>{c.half_inv_width, c.extend};
+      return std::array<float, 3>{c.half_inv_width, c.extend, c.half_inv_width_between};
     });
   }
 
@@ -637,9 +641,9 @@ class Hemisphere final : public Variant {
       for (int step = 0; step < steps_; ++step, ++offset, cone += layered ? 1 : 0) {
         const Vec3 sample = p + tangent * offset->x + bitangent * offset->y + normal * offset->z;
         if (layered && blocked < 1.0f) {
-          blocked = std::max(
-              blocked, between(f, p, normal, min_height, (previous + sample) * 0.5f,
-                               sample + (sample - previous) * cone->extend, cone->half_inv_width));
+          blocked = std::max(blocked, between(f, p, normal, min_height, (previous + sample) * 0.5f,
+                                              sample + (sample - previous) * cone->extend,
+                                              cone->half_inv_width_between));
         }
         int qx = -1, qy = -1;
         bool hidden = false, above = false;
