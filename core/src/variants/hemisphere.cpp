@@ -42,7 +42,8 @@ struct HemisphereRowArgs {
   // starting at a pixel whose x is a multiple of 4.
   const float* lane_offsets;
   // With extra layers, the same layout of each sample's cone (Hemisphere::Cone): 0.5 / its
-  // width, and how far the direction goes on past it for each unit from the step before.
+  // width, how far the direction goes on past it for each unit from the step before, and 0.5 /
+  // the width at the point halfway from the step before.
   const float* lane_cones;
   float half_inv_end_width;  // 0.5 / the cone's width at the radius
 };
@@ -148,8 +149,9 @@ HWY_INLINE VF reach_lanes(const HemisphereRowArgs& a, const LaneProjection<VF>& 
 // Hemisphere::between on the lanes of `candidate`: point (mx, my, mz), halfway between two
 // steps of a direction, lies behind the visible surface of its pixel and in front of the ray's
 // next hit, and that surface is above the receiver's tangent plane (normal n, level
-// `plane_level`): the part of the sample's cone behind it, times the solid's weight (1 where
-// the next hit is a back face, else by the assumed thickness).
+// `plane_level`): the part of the point's cone behind it or, if more, of the cone at the
+// direction's end (ex, ey, ez) past its tangent plane, times the solid's weight (1 where the
+// next hit is a back face, else by the assumed thickness).
 template <class M, class VF>
 HWY_INLINE VF between_lanes(const HemisphereRowArgs& a, const LaneProjection<VF>& project,
                             M candidate, VF mx, VF my, VF mz, VF ex, VF ey, VF ez, VF nx, VF ny,
