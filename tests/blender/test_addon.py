@@ -430,7 +430,8 @@ class AddonTest(unittest.TestCase):
         # The helper render in a Blender process of its own (the UI's way, helper_process.py)
         # on the scene with cut-outs, displacement and holdouts (materials given outputs of
         # their own, in the copy): its layers equal, bit for bit, those rendered in Blender's
-        # process (the normal to within the rounding that Blender 3.4's threads vary). A request replaced before it settles starts no process; a new render
+        # process (the normal to within the rounding that Blender 3.4's threads vary). A
+        # request replaced before it settles starts no process; a new render
         # cancels a running one (killed, files removed); a failure carries the child's message;
         # disabling the add-on kills a running one, and enabling it again begins a session
         # that remembers nothing of the last (session.py).

@@ -90,6 +90,15 @@ HWY_INLINE M plane_shown_lanes(const HemisphereRowArgs& a, const LaneProjection<
                                                       numerator * sign)));
 }
 
+// Hemisphere::end_part on lanes: the part of a direction's cone at the radius past a plane,
+// from how far the direction's end lies past it (negative: short of it); not clamped.
+template <class VF>
+HWY_INLINE VF end_part_lanes(const HemisphereRowArgs& a, VF past) {
+  namespace hn = hwy::HWY_NAMESPACE;
+  const hn::DFromV<VF> df;
+  return hn::MulAdd(past, hn::Set(df, a.half_inv_end_width), hn::Set(df, 0.5f));
+}
+
 // Hemisphere::crossing on the lanes of `candidate`, whose points a and b lie on either side of
 // the plane dot(x, c) = w: where the depth image shows the plane, or something in front of it,
 // at the point where the segment meets the plane, the part of the direction's cone past the
@@ -113,28 +122,24 @@ HWY_INLINE VF crossing_lanes(const HemisphereRowArgs& a, const LaneProjection<VF
   if (hn::AllFalse(df, on_surface)) return zero;
   const VF past_end = hn::MulAdd(hn::Abs(side_a) + hn::Abs(side_b), extend, hn::Abs(side_b)) /
                       hn::Sqrt(hn::MulAdd(cx, cx, hn::MulAdd(cy, cy, cz * cz)));
-  const VF half = hn::Set(df, 0.5f);
-  return hn::IfThenElseZero(
-      on_surface, hn::Min(one, hn::MulAdd(past_end, hn::Set(df, a.half_inv_end_width), half)));
+  return hn::IfThenElseZero(on_surface, hn::Min(one, end_part_lanes(a, past_end)));
 }
 
 // Hemisphere::reach on the lanes of `candidate`: the last sample b lies in front of the plane
-// dot(x, c) = w of the surface its pixel shows, and the direction goes on past b by `extend`
-// times b - a to the radius: the part of the cone's end past that plane, where the depth image
-// shows the plane at the point where the direction meets it (or at its end, if short of it).
+// dot(x, c) = w of the surface its pixel shows, and the direction goes on past b to its end e
+// at the radius: the part of the cone's end past that plane, where the depth image shows the
+// plane at the point where the direction meets it (or at its end, if short of it).
 template <class M, class VF>
 HWY_INLINE VF reach_lanes(const HemisphereRowArgs& a, const LaneProjection<VF>& project,
-                          M candidate, VF ax, VF ay, VF az, VF bx, VF by, VF bz, VF cx, VF cy,
-                          VF cz, VF w, VF extend) {
+                          M candidate, VF bx, VF by, VF bz, VF ex, VF ey, VF ez, VF cx, VF cy,
+                          VF cz, VF w) {
   namespace hn = hwy::HWY_NAMESPACE;
   const hn::DFromV<VF> df;
-  const VF zero = hn::Zero(df), one = hn::Set(df, 1.0f), half = hn::Set(df, 0.5f);
-  const VF ex = hn::MulAdd(bx - ax, extend, bx), ey = hn::MulAdd(by - ay, extend, by),
-           ez = hn::MulAdd(bz - az, extend, bz);
+  const VF zero = hn::Zero(df), one = hn::Set(df, 1.0f);
   const VF side_b = hn::MulAdd(bx, cx, hn::MulAdd(by, cy, bz * cz)) - w;
   const VF side_e = hn::MulAdd(ex, cx, hn::MulAdd(ey, cy, ez * cz)) - w;
   const VF inv_length = one / hn::Sqrt(hn::MulAdd(cx, cx, hn::MulAdd(cy, cy, cz * cz)));
-  const VF part = hn::NegMulAdd(side_e * inv_length, hn::Set(df, a.half_inv_end_width), half);
+  const VF part = end_part_lanes(a, hn::Neg(side_e * inv_length));
   const auto lanes = hn::And(candidate, hn::And(hn::Gt(side_b, zero), hn::Gt(part, zero)));
   if (hn::AllFalse(df, lanes)) return zero;
   const auto short_of = hn::Ge(side_e, zero);
@@ -188,9 +193,9 @@ HWY_INLINE VF between_lanes(const HemisphereRowArgs& a, const LaneProjection<VF>
   const VF qxv = ray_x * q_scale, qyv = ray_y * q_scale, qzv = hn::Neg(qd);
   const VF side_e = hn::MulAdd(ex - qxv, cx, hn::MulAdd(ey - qyv, cy, (ez - qzv) * cz));
   const VF past_end = hn::Neg(side_e) / hn::Sqrt(hn::MulAdd(cx, cx, hn::MulAdd(cy, cy, cz * cz)));
-  const VF covered = hn::Min(
-      one, hn::Max(zero, hn::Max(hn::MulAdd(behind * scale, half_inv_width, half),
-                                 hn::MulAdd(past_end, hn::Set(df, a.half_inv_end_width), half))));
+  const VF covered =
+      hn::Min(one, hn::Max(zero, hn::Max(hn::MulAdd(behind * scale, half_inv_width, half),
+                                         end_part_lanes(a, past_end))));
   const VF thick = hn::Min(one, hn::Max(zero, hn::NegMulAdd(behind, hn::Set(df, 1.0f / a.thickness),
                                                             hn::Set(df, 2.0f))));
   return hn::IfThenElseZero(inside, covered * hn::IfThenElse(hn::Lt(next, zero), one, thick));
@@ -317,15 +322,16 @@ HWY_NOINLINE void hemisphere_row_of(const HemisphereRowArgs& a, int y, int x0, i
           const VF half_inv_width = hn::LoadU(df, cone), extend = hn::LoadU(df, cone + kLaneTable);
           const VF half_inv_width_between = hn::LoadU(df, cone + 2 * kLaneTable);
           cone += 3 * kLaneTable;
+          // The direction's end at the radius.
+          const VF end_x = hn::MulAdd(sx - ax, extend, sx), end_y = hn::MulAdd(sy - ay, extend, sy),
+                   end_z = hn::MulAdd(sz - az, extend, sz);
           // Halfway from the previous point (Hemisphere::between).
           const auto open_lanes = hn::And(receiver, hn::Lt(blocked, one));
           if (!hn::AllFalse(df, open_lanes)) {
             blocked = hn::Max(
-                blocked,
-                between_lanes(a, project, open_lanes, (ax + sx) * half, (ay + sy) * half,
-                              (az + sz) * half, hn::MulAdd(sx - ax, extend, sx),
-                              hn::MulAdd(sy - ay, extend, sy), hn::MulAdd(sz - az, extend, sz), nx,
-                              ny, nz, plane_level, half_inv_width_between));
+                blocked, between_lanes(a, project, open_lanes, (ax + sx) * half, (ay + sy) * half,
+                                       (az + sz) * half, end_x, end_y, end_z, nx, ny, nz,
+                                       plane_level, half_inv_width_between));
           }
           auto hidden = none;
           auto above = none;  // the visible surface lies above the tangent plane: it may occlude
@@ -437,8 +443,8 @@ HWY_NOINLINE void hemisphere_row_of(const HemisphereRowArgs& a, int y, int x0, i
             }
           }
           if (!hn::AllFalse(df, ends)) {
-            blocked = hn::Max(blocked, reach_lanes(a, project, ends, ax, ay, az, sx, sy, sz, hnx,
-                                                   hny, hnz, hw, extend));
+            blocked = hn::Max(blocked, reach_lanes(a, project, ends, sx, sy, sz, end_x, end_y,
+                                                   end_z, hnx, hny, hnz, hw));
           }
           ax = sx, ay = sy, az = sz;
           previous_hidden = hidden;
@@ -642,10 +648,11 @@ class Hemisphere final : public Variant {
       Vec3 previous_surface{}, previous_normal{};
       for (int step = 0; step < steps_; ++step, ++offset, cone += layered ? 1 : 0) {
         const Vec3 sample = p + tangent * offset->x + bitangent * offset->y + normal * offset->z;
+        // The direction's end at the radius (with extra layers).
+        const Vec3 end = layered ? sample + (sample - previous) * cone->extend : Vec3{};
         if (layered && blocked < 1.0f) {
           blocked = std::max(blocked, between(f, p, normal, min_height, (previous + sample) * 0.5f,
-                                              sample + (sample - previous) * cone->extend,
-                                              cone->half_inv_width_between));
+                                              end, cone->half_inv_width_between));
         }
         int qx = -1, qy = -1;
         bool hidden = false, above = false;
@@ -696,8 +703,7 @@ class Hemisphere final : public Variant {
                                          here ? surface_normal : previous_normal, cone->extend));
         }
         if (ends && blocked < 1.0f) {
-          blocked =
-              std::max(blocked, reach(f, previous, sample, surface, surface_normal, cone->extend));
+          blocked = std::max(blocked, reach(f, sample, end, surface, surface_normal));
         }
         previous = sample;
         previous_hidden = hidden;
@@ -727,43 +733,48 @@ class Hemisphere final : public Variant {
     const Vec3 c = a + (b - a) * (side_a / (side_a - side_b));
     if (!shows_plane(f, c, q, nq)) return 0.0f;
     const float past_end = (std::fabs(side_a) + std::fabs(side_b)) * extend + std::fabs(side_b);
-    return std::min(1.0f, past_end / length(nq) * half_inv_end_width_ + 0.5f);
+    return std::min(1.0f, end_part(past_end / length(nq)));
   }
+
+  // The part of a direction's cone at the radius past a plane, from how far the direction's end
+  // lies past it (negative: short of it): half where the end lies on it, none half the cone's
+  // width short of it. Not clamped.
+  float end_part(float past) const { return past * half_inv_end_width_ + 0.5f; }
 
   // A point halfway between two steps of a direction (a 2 cm board seen edge-on is a pixel or
   // two wide on screen and falls between steps that lie several pixels apart): when it lies
   // behind the visible surface of its pixel, in front of the ray's next hit, and that surface is
-  // above the receiver's tangent plane (p, normal, min_height), the part of the sample's cone
-  // behind the surface times the solid's weight: 1 when the next hit is a back face that closes
-  // it, else by the assumed thickness. Cheaper than a step: no deeper hits, no crossing test.
+  // above the receiver's tangent plane (p, normal, min_height), the part of the point's cone
+  // (0.5 / its width: half_inv_width) behind the surface or, if more, of the cone at the
+  // direction's end past the surface's tangent plane, times the solid's weight: 1 when the next
+  // hit is a back face that closes it, else by the assumed thickness. Cheaper than a step: no
+  // deeper hits, no crossing test.
   float between(const Frame& f, Vec3 p, Vec3 normal, float min_height, Vec3 point, Vec3 end,
                 float half_inv_width) const {
     int qx, qy;
     if (!pixel_of_sample(f, point, qx, qy) || !f.is_geometry(qx, qy)) return 0.0f;
     const float behind = -point.z - f.depth(qx, qy);
-    if (!(behind > 0.0f) || !(dot(f.position(qx, qy) - p, normal) > min_height)) return 0.0f;
+    const Vec3 q = f.position(qx, qy);
+    if (!(behind > 0.0f) || !(dot(q - p, normal) > min_height)) return 0.0f;
     const float next = f.layer_planes()[f.index(qx, qy)];  // the ray's 2nd hit
     if (!(-point.z <= std::fabs(next))) return 0.0f;
     const float weight = next < 0.0f ? 1.0f : thickness_weight(behind, thickness_);
     // The direction goes on to `end`: the part of its cone there past the surface's tangent
     // plane, if more (a board the direction pierces blocks the whole cone, however thin).
     const Vec3 nq = f.normal(qx, qy);
-    const float past_end = -dot(end - f.position(qx, qy), nq) / length(nq);
-    return saturate(std::max(behind * f.plane_distance_scale(qx, qy) * half_inv_width,
-                             past_end * half_inv_end_width_) +
-                    0.5f) *
+    const float past_end = -dot(end - q, nq) / length(nq);
+    return saturate(std::max(behind * f.plane_distance_scale(qx, qy) * half_inv_width + 0.5f,
+                             end_part(past_end))) *
            weight;
   }
 
-  // When the last sample b of a direction (the one before: a) lies in front of the tangent
-  // plane (point q, normal nq) of the surface its pixel shows, and the direction goes on beyond
-  // b by `extend` times b - a to the radius: the part of the cone's end past that plane (half
-  // where the end lies on it, none half a cone's width short of it), if the depth image shows
-  // the plane where the direction meets it (at its end, when short of it). Else 0.
-  float reach(const Frame& f, Vec3 a, Vec3 b, Vec3 q, Vec3 nq, float extend) const {
-    const Vec3 end = b + (b - a) * extend;
+  // When the last sample b of a direction lies in front of the tangent plane (point q, normal
+  // nq) of the surface its pixel shows, and the direction goes on beyond b to its end at the
+  // radius: the part of the cone's end past that plane (end_part), if the depth image shows the
+  // plane where the direction meets it (at its end, when short of it). Else 0.
+  float reach(const Frame& f, Vec3 b, Vec3 end, Vec3 q, Vec3 nq) const {
     const float side_b = dot(b - q, nq), side_end = dot(end - q, nq);
-    const float part = 0.5f - side_end / length(nq) * half_inv_end_width_;
+    const float part = end_part(-side_end / length(nq));
     if (!(side_b > 0.0f) || !(part > 0.0f)) return 0.0f;
     const Vec3 c = side_end >= 0.0f ? end : b + (end - b) * (side_b / (side_b - side_end));
     return shows_plane(f, c, q, nq) ? std::min(1.0f, part) : 0.0f;
