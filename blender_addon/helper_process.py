@@ -24,6 +24,7 @@ import json
 import os
 import shutil
 import subprocess
+import sys
 import tempfile
 import threading
 import time
@@ -60,6 +61,41 @@ except Exception as error:
 """
 
 
+def write_scene_copy(scene, folder):
+    """Writes `scene` and every data-block it uses to folder/scene.blend (paths made absolute),
+    for a Blender of its own to open; returns its path."""
+    blend = os.path.join(folder, "scene.blend")
+    bpy.data.libraries.write(blend, {scene}, path_remap='ABSOLUTE', compress=False)
+    return blend
+
+
+def child_command(blend, script, args):
+    """The command that runs `script` (Python) in a background Blender (this executable, its
+    factory settings) on `blend`; the script reads json `args`, with "addon_parent" and
+    "package" added: where it imports this add-on from."""
+    addon = os.path.dirname(os.path.abspath(__file__))
+    args = {"addon_parent": os.path.dirname(addon),
+            "package": __package__.rpartition(".")[2],  # the folder's name, top-level
+            **args}
+    # Drivers and other Python in the file run in the copy only where they run here: the
+    # preference, or -y on the command line (a farm's render), unless this file's were blocked.
+    allowed = bpy.context.preferences.filepaths.use_scripts_auto_execute or \
+        any(a in ("-y", "--enable-autoexec") for a in sys.argv)
+    autoexec = "-y" if allowed and not bpy.app.autoexec_fail else "-Y"
+    return [bpy.app.binary_path, "-b", "--factory-startup", "-noaudio", autoexec, blend,
+            "--python-exit-code", "3", "--python-expr", script, "--", json.dumps(args)]
+
+
+def log_tail(log, returncode):
+    """Why a child Blender failed, from the end of its output."""
+    try:
+        with open(log, errors="replace") as f:
+            lines = [line.rstrip() for line in f if line.strip()]
+    except OSError:
+        lines = []
+    return f"Blender exit status {returncode}: " + (" | ".join(lines[-LOG_TAIL:]) or "no output")
+
+
 class _Request:
     def __init__(self, key, hits, overscan, replacing):
         self.key, self.hits, self.overscan = key, hits, overscan
@@ -82,22 +118,14 @@ class _Render:
             raise
 
     def _start(self, scene, hits, overscan):
-        blend = os.path.join(self.folder, "scene.blend")
-        bpy.data.libraries.write(blend, {scene}, path_remap='ABSOLUTE', compress=False)
+        blend = write_scene_copy(scene, self.folder)
         self.output = os.path.join(self.folder, "layers.npz")
-        package = __package__.rpartition(".")[2]  # the folder's name, as a top-level package
-        addon = os.path.dirname(os.path.abspath(__file__))
         camera = scene.camera
-        args = {"addon_parent": os.path.dirname(addon), "package": package,
-                "scene": scene.name, "frame": scene.frame_current,
-                "subframe": scene.frame_subframe, "hits": hits, "overscan": overscan,
-                "camera_matrix": camera and [list(row) for row in camera.matrix_world],
-                "folder": self.folder, "output": self.output}
-        # Drivers and other Python in the file run in the copy only where the user lets them.
-        autoexec = "-y" if bpy.context.preferences.filepaths.use_scripts_auto_execute \
-            else "-Y"
-        command = [bpy.app.binary_path, "-b", "--factory-startup", "-noaudio", autoexec, blend,
-                   "--python-exit-code", "3", "--python-expr", _CHILD, "--", json.dumps(args)]
+        command = child_command(blend, _CHILD, {
+            "scene": scene.name, "frame": scene.frame_current,
+            "subframe": scene.frame_subframe, "hits": hits, "overscan": overscan,
+            "camera_matrix": camera and [list(row) for row in camera.matrix_world],
+            "folder": self.folder, "output": self.output})
         self.log = os.path.join(self.folder, "helper.log")
         with open(self.log, "w") as log:
             self.process = subprocess.Popen(
@@ -138,14 +166,7 @@ class _Render:
             with open(self.output + ".error", errors="replace") as f:
                 return f.read()
         except OSError:
-            pass
-        try:
-            with open(self.log, errors="replace") as f:
-                lines = [line.rstrip() for line in f if line.strip()]
-        except OSError:
-            lines = []
-        return (f"Blender exit status {self.process.returncode}: " +
-                (" | ".join(lines[-LOG_TAIL:]) or "no output"))
+            return log_tail(self.log, self.process.returncode)
 
     def cancel(self):
         """Stops the process (if it runs) and removes its files."""
