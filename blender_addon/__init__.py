@@ -10,8 +10,9 @@ ssao (the Python module core/python/ssao, the one ctypes binding; a link in the 
 copy in the zip), recomposite (running the compositor again), multilayer (EXR layers),
 saved_form (how a .blend carries the node), handlers (render and file events), main_thread
 (render-thread handlers' work done on the main thread), session (everything the add-on
-remembers between events: one object, begun by register()), operators, preferences, camera,
-compat (every Blender-version difference)."""
+remembers between events: one object, begun by register()), helper_process and warm_up
+(background Blenders: the UI's helper render, the frames before a headless job's first),
+operators, preferences, camera, compat (every Blender-version difference)."""
 
 bl_info = {
     "name": "Ambient Occlusion (SSAO) compositor node",

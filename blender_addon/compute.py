@@ -1,6 +1,7 @@
 # SPDX-License-Identifier: MIT
 """Computing the AO: the node's exported passes in, libssao, the node's AO image out."""
 import functools
+import json
 import math
 import os
 import tempfile
@@ -313,21 +314,78 @@ class Sequences:
     ssao.Sequence per SSAO node, in which the library's temporal filter (the node's
     temporal_frames) averages each frame with the frames before it, carried through depth and
     camera. A frame seen through another camera object than the one before (a cut by camera
-    markers) starts the node's sequence again."""
+    markers) starts the node's sequence again.
 
-    def __init__(self):
+    With `record_to` (a folder) each frame's library inputs are also saved there, in order, for
+    replay() to give another process's Sequences (warm_up.py: the frames before a farm chunk).
+    `warmed_up` is warm_up.py's: whether the frames before the first were given."""
+
+    def __init__(self, record_to=None):
         self._shots = {}  # (scene name, node name) -> (camera name, ssao.Sequence)
+        self._record_to = record_to
+        self._recorded = 0
+        self.warmed_up = False
 
     def shot(self, scene, node):
-        """The ssao.Sequence of `node` for the scene's frame."""
-        key = (scene.name, node.name)
+        """The frames' library call for `node` at the scene's frame: ambient_occlusion(depth,
+        frame=, **arguments) of the node's ssao.Sequence (recorded when recording)."""
         camera = scene.camera.name if scene.camera is not None else ""
+        sequence = self._sequence(scene.name, node.name, camera)
+        if self._record_to is None:
+            return sequence
+        return types.SimpleNamespace(ambient_occlusion=functools.partial(
+            self._record, sequence, (scene.name, node.name, camera)))
+
+    def _sequence(self, scene_name, node_name, camera):
+        key = (scene_name, node_name)
         kept = self._shots.get(key)
         if kept is None or kept[0] != camera:
             if kept is not None:
                 kept[1].close()
             kept = self._shots[key] = (camera, ssao.Sequence(library()))
         return kept[1]
+
+    def _record(self, sequence, names, depth, *, frame, **arguments):
+        """Saves one frame's inputs (arrays as arrays, the rest as JSON; run_stats is an
+        output), then computes it."""
+        arrays = {"depth": depth}
+        values = {}
+        for name, value in arguments.items():
+            if isinstance(value, np.ndarray):
+                arrays[name] = value
+            elif isinstance(value, list) and value and isinstance(value[0], np.ndarray):
+                arrays.update({f"{name}.{i}": v for i, v in enumerate(value)})
+                values[name] = {"arrays": len(value)}
+            elif name != "run_stats":
+                values[name] = {"value": value.item() if isinstance(value, np.generic)
+                                else value}
+        meta = {"names": names, "frame": frame, "values": values}
+        path = os.path.join(self._record_to, f"{self._recorded:05d}.npz")
+        np.savez(path, meta=np.array(json.dumps(meta)), **arrays)
+        self._recorded += 1
+        return sequence.ambient_occlusion(depth, frame=frame, **arguments)
+
+    def replay(self, folder):
+        """Computes the frames another process's Sequences recorded in `folder`, in their
+        order, as if this one had: the temporal filter then has them for the frames after.
+        Returns how many; a frame the library refused takes no part, as it did there."""
+        paths = sorted(p for p in os.listdir(folder) if p.endswith(".npz"))
+        for name in paths:
+            with np.load(os.path.join(folder, name), allow_pickle=False) as stored:
+                meta = json.loads(str(stored["meta"]))
+                arguments = {}
+                for key, value in meta["values"].items():
+                    arguments[key] = [stored[f"{key}.{i}"] for i in range(value["arrays"])] \
+                        if "arrays" in value else value["value"]
+                arguments.update({key: stored[key] for key in stored.files
+                                  if key not in ("meta", "depth") and "." not in key})
+                depth = stored["depth"]
+            try:
+                self._sequence(*meta["names"]).ambient_occlusion(depth, frame=meta["frame"],
+                                                                 **arguments)
+            except ssao.SSAOError:
+                pass
+        return len(paths)
 
     def close(self):
         for _, shot in self._shots.values():

@@ -14,7 +14,8 @@ inner_tree.py). Then:
     AO, then computes the current frame's AO and nudges the UI compositor, which re-composites
     the Render Result on screen.
 The frames of one animation render are one sequence (compute.Sequences), whose temporal filter
-averages each frame's AO with the frames before it; a still is computed alone.
+averages each frame's AO with the frames before it; headless, a job that does not start the shot
+renders the frames before its first beforehand (warm_up.py); in the UI a still is computed alone.
 Changing a node property recomputes from the exported passes, without rendering.
 (Measured facts behind this design: docs/blender.md.)"""
 import atexit
@@ -26,7 +27,7 @@ import time
 import bpy
 
 from . import compat, compute, helper_process, hidden_surfaces, inner_tree, recomposite, \
-    saved_form, session
+    saved_form, session, warm_up
 from .compute import report
 
 
@@ -79,7 +80,7 @@ def _on_render_init(*_):
     if not bpy.app.background or state.helper_rendering():
         return
     _end_sequences()
-    state.sequences = compute.Sequences()
+    state.sequences = compute.Sequences(record_to=state.record_to)
 
 
 @bpy.app.handlers.persistent
@@ -141,6 +142,11 @@ def _on_render_post(scene, *_):
         _warn_movie_once(scene)
     # Headless, the scene's objects (the camera) still hold the frame the file was saved at.
     scene.frame_set(frame)
+    sequences = state.sequences
+    if sequences is not None and not sequences.warmed_up and state.record_to is None:
+        # The job's first frame: its render is in the Render Result, the rest is below.
+        warm_up.warm_up(scene, frame, sequences)
+        scene.frame_set(frame)
     aos = compute.compute_frame(scene, frame, state.render_started,
                                 sequences=state.sequences)
     # Nothing computed: the render's own composite is already the image without AO.
@@ -471,7 +477,14 @@ def _pack_and_point_at_saved_folder(scene, node):
 @bpy.app.handlers.persistent
 def _on_load_post(*_):
     helper_process.cancel()  # another file: its scenes are others, even under the same names
+    _record_shot_starts()
     set_up_nodes()
+
+
+def _record_shot_starts():
+    """Where each scene's shot starts, as saved: before `-s` on the command line changes it
+    (warm_up.py)."""
+    session.current.shot_starts = {s.name: s.frame_start for s in bpy.data.scenes}
 
 
 @bpy.app.handlers.persistent
@@ -510,6 +523,7 @@ def register():
         bpy.app.timers.register(_process_pending, first_interval=0.2, persistent=True)
     # Nodes of a file that is already open (enabling the add-on after loading).
     try:
+        _record_shot_starts()
         set_up_nodes()
     except AttributeError:  # bpy.data is restricted while add-ons register at start-up
         pass

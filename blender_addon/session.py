@@ -25,6 +25,8 @@ class Session:
         self.written_frames = []   # UI: (scene name, frame, output file, passes file), Ctrl+F12
         self.recomposited = {}     # headless: (scene name, frame) -> (passes file, AO layers)
         self.sequences = None      # headless: the render job's compute.Sequences (init to end)
+        self.shot_starts = {}      # scene name -> frame_start as the file was loaded (warm_up.py)
+        self.record_to = None      # warm_up.py's child: where its Sequences record the frames
         self.movie_warned = set()  # scenes told once that a movie cannot be written again
         self.run_with_writes = None  # what the window manager property's update runs
         self.nudge_scene = None    # the scene whose UI compositor is nudged until it runs
