@@ -677,6 +677,25 @@ class AddonTest(unittest.TestCase):
             np.testing.assert_allclose(ao, aos[frame - 1], atol=1e-5, rtol=0,
                                        err_msg=f"chunk frame {frame}")
 
+    def test_a_farm_chunk_with_the_node_defaults_is_the_whole_shot(self):
+        # The defaults' hidden surfaces and band: the frames before the chunk bring their
+        # helper renders' layers too.
+        folder = self.folder("chunk_defaults")
+        blend = self.blender.build_scene("chunk_defaults/scene", "--frames", "3",
+                                         "--output", os.path.join(folder, "out_####.exr"),
+                                         "--passes-dir", os.path.join(folder, "passes"))
+        self.blender.run(blend, "-a")
+        passes = os.path.join(folder, "passes", "0003.exr")
+        shot = self.assert_composite_is_beauty_times_ao(
+            os.path.join(folder, "out_0003.exr"), passes)[0]
+        log = self.blender.run(blend, "-o", os.path.join(folder, "chunk", "out_####.exr"),
+                               "-s", "3", "-e", "3", "-a")
+        self.assertIn("frames before it (1, 2) rendered first", log)
+        chunk = self.assert_composite_is_beauty_times_ao(
+            os.path.join(folder, "chunk", "out_0003.exr"), passes)[0]
+        self.assertLess(float(shot.mean()), 0.97, "there is AO")
+        np.testing.assert_allclose(chunk, shot, atol=1e-5, rtol=0)
+
     def test_multilayer_output_holds_the_composite_with_ao(self):
         folder = self.folder("multilayer")
         blend = self.blender.build_scene("multilayer/scene", "--format", "OPEN_EXR_MULTILAYER",
