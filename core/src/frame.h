@@ -158,11 +158,14 @@ class Frame {
   Vec3 reconstructed_normal(int x, int y) const;
   void fill_depth(const FrameInputs& in, TilePool& pool, Progress& progress);
   void build_normals(const FrameInputs& in, TilePool& pool, Progress& progress);
+  // Gives each pixel whose normal is a mix of surfaces (mixed_normal_) the normal of the
+  // neighbour on its own surface that the mix leans to most (see frame.cpp).
+  void unmix_normals(TilePool& pool, Progress& progress);
   // A row's normal image values, as planes, before they are packed.
   struct NormalRow {
     explicit NormalRow(int count);
     ScratchVector<float> nx, ny, nz;
-    ScratchVector<uint32_t> usable;
+    ScratchVector<uint32_t> usable, mixed;
   };
   void pack_normals_row(const FrameInputs& in, const float* rotation, const Frame& source,
                         const int32_t* xs, const int32_t* ys, int x0, int y, int count,
@@ -170,7 +173,8 @@ class Frame {
   static void nearest_of_blocks(const float* top, const float* bottom, int count, float* depth,
                                 int32_t* corner);
   void encode_normal_row(const float* rotation, float v, int x0, int count, const float* nx,
-                         const float* ny, const float* nz, uint32_t* usable, uint32_t* out) const;
+                         const float* ny, const float* nz, uint32_t* usable, uint32_t* mixed,
+                         uint32_t* out) const;
 
   // Fills last_thickness_ from the finished depth and layer planes.
   void infer_last_thickness(TilePool& pool, Progress& progress);
@@ -192,6 +196,9 @@ class Frame {
   int width_ = 0, height_ = 0, extra_layers_ = 0;
   std::vector<float> depth_;
   std::vector<uint32_t> normal_;
+  // 1 where the normal image's normal was shorter than kMixedNormalLength (a pixel filtered over
+  // two surfaces), else 0 (background pixels may have either); sized with normal_.
+  std::vector<uint8_t> mixed_normal_;
   std::vector<float> layers_;
   std::vector<float> last_thickness_;
   std::vector<float> plane_distance_scale_;
