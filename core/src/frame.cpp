@@ -24,6 +24,9 @@ constexpr float kMixedNormalLength = 0.99f;
 // A neighbour is on a mixed pixel's own surface when the pixel's position lies within this many
 // pixel footprints of the neighbour's tangent plane.
 constexpr float kOwnSurfaceFootprints = 2.0f;
+// A mix is a concave crease when a neighbour lies more than this many pixel footprints above the
+// chosen normal's tangent plane (the other surface rises in front of it).
+constexpr float kConcaveFootprints = 0.25f;
 
 void Frame::reset(const CameraModel& camera, int width, int height, int extra_layers) {
   camera_ = camera;
@@ -250,14 +253,16 @@ void Frame::build_normals(const FrameInputs& in, TilePool& pool, Progress& progr
   });
 }
 
-// A mixed pixel's AO must be its own surface's: with the average normal the estimate sees the
-// hemisphere of a surface tilted halfway between both, which on a concave crease looks past
-// the other wall and reads light (a light line along every wall-floor junction). Of the four
+// On a concave crease a mixed pixel's AO must be its own surface's: with the average normal the
+// estimate sees the hemisphere of a surface tilted halfway between both, which looks past the
+// other wall and reads light (a light line along every wall-floor junction). Of the four
 // neighbours whose normal is not mixed and on whose tangent plane the pixel lies (within
 // kOwnSurfaceFootprints), the one whose normal the mix leans to most gives its normal (the
-// diagonal ones as well changed the benchmark's errors by less than 1e-4). A pixel without
-// such a neighbour keeps its own. Only mixed pixels are written and only unmixed ones read, so
-// tiles run in place and in any order.
+// diagonal ones as well changed the benchmark's errors by less than 1e-4), when the crease is
+// concave. On a convex edge the average normal sees about the mix of both faces' AO and keeps
+// it: there a switch to one face's normal as the edge moves across the pixel made the AO
+// flicker on camera moves. A pixel without such a neighbour keeps its own. Only mixed pixels
+// are written and only unmixed ones read, so tiles run in place and in any order.
 void Frame::unmix_normals(TilePool& pool, Progress& progress) {
   const CameraIntrinsics cam = camera_.intrinsics();
   pool.for_each_tile(width_, height_, progress, [&](const Tile& t) {
@@ -287,7 +292,14 @@ void Frame::unmix_normals(TilePool& pool, Progress& progress) {
           const float lean = dot(mix, n);
           if (lean > best) best = lean, chosen = normal_[index(qx, qy)];
         }
-        normal_[index(x, y)] = chosen;
+        const Vec3 own = decode_normal(chosen);
+        bool concave = false;
+        for (const auto& [qx, qy] : neighbours) {
+          if (qx < 0 || qy < 0 || qx >= width_ || qy >= height_ || !is_geometry(qx, qy)) continue;
+          concave = concave || dot(position(qx, qy) - p, own) >
+                                   kConcaveFootprints / kOwnSurfaceFootprints * tolerance;
+        }
+        if (concave) normal_[index(x, y)] = chosen;
       }
     }
   });
