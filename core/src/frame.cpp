@@ -264,7 +264,7 @@ void Frame::build_normals(const FrameInputs& in, TilePool& pool, Progress& progr
 // flicker on camera moves. A pixel without such a neighbour keeps its own. Only mixed pixels
 // are written and only unmixed ones read, so tiles run in place and in any order.
 void Frame::unmix_normals(TilePool& pool, Progress& progress) {
-  const CameraIntrinsics cam = camera_.intrinsics();
+  const auto inside = [&](int x, int y) { return x >= 0 && y >= 0 && x < width_ && y < height_; };
   pool.for_each_tile(width_, height_, progress, [&](const Tile& t) {
     for (int y = t.y0; y < t.y1; ++y) {
       const uint8_t* mixed = mixed_normal_.data() + index(0, y);
@@ -279,25 +279,25 @@ void Frame::unmix_normals(TilePool& pool, Progress& progress) {
         }
         if (!mixed[x] || !is_geometry(x, y)) continue;
         const Vec3 mix = normal(x, y), p = position(x, y);
-        const float tolerance =
-            kOwnSurfaceFootprints * cam.scale_u * (cam.orthographic ? 1.0f : depth(x, y));
-        float best = -2.0f;
-        uint32_t chosen = normal_[index(x, y)];
+        const float footprint = camera_.pixel_footprint(depth(x, y));
         const int neighbours[4][2] = {{x - 1, y}, {x + 1, y}, {x, y - 1}, {x, y + 1}};
+        float best = -2.0f;
+        uint32_t chosen = 0;
         for (const auto& [qx, qy] : neighbours) {
-          if (qx < 0 || qy < 0 || qx >= width_ || qy >= height_) continue;
-          if (mixed_normal_[index(qx, qy)] || !is_geometry(qx, qy)) continue;
+          if (!inside(qx, qy) || mixed_normal_[index(qx, qy)] || !is_geometry(qx, qy)) continue;
           const Vec3 n = normal(qx, qy);
-          if (!(std::fabs(dot(p - position(qx, qy), n)) <= tolerance)) continue;
+          if (!(std::fabs(dot(p - position(qx, qy), n)) <= kOwnSurfaceFootprints * footprint)) {
+            continue;
+          }
           const float lean = dot(mix, n);
           if (lean > best) best = lean, chosen = normal_[index(qx, qy)];
         }
+        if (best < -1.0f) continue;  // no neighbour on the pixel's own surface
         const Vec3 own = decode_normal(chosen);
         bool concave = false;
         for (const auto& [qx, qy] : neighbours) {
-          if (qx < 0 || qy < 0 || qx >= width_ || qy >= height_ || !is_geometry(qx, qy)) continue;
-          concave = concave || dot(position(qx, qy) - p, own) >
-                                   kConcaveFootprints / kOwnSurfaceFootprints * tolerance;
+          if (!inside(qx, qy) || !is_geometry(qx, qy)) continue;
+          concave = concave || dot(position(qx, qy) - p, own) > kConcaveFootprints * footprint;
         }
         if (concave) normal_[index(x, y)] = chosen;
       }

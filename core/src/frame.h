@@ -158,8 +158,8 @@ class Frame {
   Vec3 reconstructed_normal(int x, int y) const;
   void fill_depth(const FrameInputs& in, TilePool& pool, Progress& progress);
   void build_normals(const FrameInputs& in, TilePool& pool, Progress& progress);
-  // Gives each pixel whose normal is a mix of surfaces (mixed_normal_) the normal of the
-  // neighbour on its own surface that the mix leans to most (see frame.cpp).
+  // Gives each pixel whose normal is a mix of surfaces (mixed_normal_) on a concave crease the
+  // normal of the neighbour on its own surface that the mix leans to most (see frame.cpp).
   void unmix_normals(TilePool& pool, Progress& progress);
   // A row's normal image values, as planes, before they are packed.
   struct NormalRow {
