@@ -216,7 +216,9 @@ void Frame::build_depth(const FrameInputs& in, TilePool& pool, Progress& progres
 
 void Frame::fill_depth(const FrameInputs& in, TilePool& pool, Progress& progress) {
   const float limit = in.background_limit;
-  pool.for_each_tile(width_, height_, progress, [&](const Tile& t) {
+  // Whole rows, so that each input plane (seven with three layers) is read as one stream: in
+  // 128 x 32 tiles a layered 2048x1208 run without its kernel took 1.2x as long.
+  pool.for_each_row_band(width_, height_, 8, progress, [&](const Tile& t) {
     ScratchVector<float> facing(extra_layers_ > 0 ? size_t(t.x1 - t.x0) : 0);
     for (int y = t.y0; y < t.y1; ++y) {
       float* row = depth_.data() + index(t.x0, y);
