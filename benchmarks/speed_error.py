@@ -47,7 +47,8 @@ LAYERS_SCRIPT = os.path.join(BLENDER_SCRIPTS, "benchmark_layers.py")
 LAYERS_SOURCES = KIT_SCRIPTS + [LAYERS_SCRIPT, os.path.join(BLENDER_SCRIPTS, "render_layers.py")] + [
     os.path.join(REPO_ROOT, "blender_addon", name)
     for name in ("hidden_surfaces.py", "multilayer.py", "compat.py")]
-GUARD_BAND = 64
+# The layers rows' guard band and extra depth layers: the Blender node's defaults (crops.py).
+GUARD_BAND, EXTRA_LAYERS = crops.GUARD_BAND, crops.EXTRA_LAYERS
 CSV_COLUMNS = ["scene", "method", "setting", "threads", "time_s", "rmse", "bias", "band",
                "edge_rmse"]
 
@@ -88,12 +89,13 @@ LIBRARY_QUICK = [
     ("horizon", "quality=medium", ["variant=horizon"]),
     ("sphere", "quality=medium", ["variant=sphere"]),
 ]
-# The default with what an offline renderer can add (ssao_eval --layers): the 2nd and 3rd surface
+# The default with what an offline renderer can add (ssao_eval --layers): the 2nd to 4th surface
 # hits with their facing, a guard band around the frame, both.
 LAYER_ROWS = [
-    ("hemisphere", "layers=2", ["layers=2"]),
+    ("hemisphere", "layers=%d" % EXTRA_LAYERS, ["layers=%d" % EXTRA_LAYERS]),
     ("hemisphere", "band=%d" % GUARD_BAND, ["band=%d" % GUARD_BAND]),
-    ("hemisphere", "layers=2,band=%d" % GUARD_BAND, ["layers=2", "band=%d" % GUARD_BAND]),
+    ("hemisphere", "layers=%d,band=%d" % (EXTRA_LAYERS, GUARD_BAND),
+     ["layers=%d" % EXTRA_LAYERS, "band=%d" % GUARD_BAND]),
 ]
 # The straight ports of the seed tutorials (tests/reference/seed_ports.cpp) and the brute-force
 # ray march (the accuracy floor of any depth-buffer method; only at 640x360, it is slow).
@@ -578,7 +580,7 @@ def error_cell(values, bold=False):
 
 def layers_table(rows):
     """Per scene: the default's RMSE / band / edge RMSE alone, with the extra depth layers, with
-    the guard band and with both, and the time with layers over the default's; then the
+    the guard band and with both, and the time with layers and band over the default's; then the
     means."""
     settings = ["default"] + [setting for _, setting, _ in LAYER_ROWS]
     measures = ("rmse", "band", "edge_rmse")
@@ -591,12 +593,12 @@ def layers_table(rows):
         for s in settings:
             means[s].append([found[s][m] for m in measures])
         lines.append([scene] + [error_cell(found[s][m] for m in measures) for s in settings] +
-                     ["%.2fx" % (found[LAYER_ROWS[0][1]]["time_s"] / found["default"]["time_s"])])
+                     ["%.2fx" % (found[LAYER_ROWS[-1][1]]["time_s"] / found["default"]["time_s"])])
     if not lines:
         return "(no scene has its layers file)"
     lines.append(["**mean**"] + [error_cell((statistics.mean(column) for column in zip(*means[s])),
                                             bold=True) for s in settings] + [""])
-    return markdown_table(["scene", "one layer (default)", "+ 2nd, 3rd hits",
+    return markdown_table(["scene", "one layer (default)", "+ 2nd to 4th hits",
                            "+ %d px band" % GUARD_BAND, "+ both", "time with layers"], lines)
 
 
@@ -637,16 +639,17 @@ def write_markdown(path, images, args, plan, rows, table, complexity, noise, mac
         "",
         "## Beyond one depth layer",
         "",
-        "The default with what an offline renderer can add: the 2nd and 3rd surface hits along "
-        "each pixel's ray with their facing (`depth2`, `depth3`, `facing2`, `facing3`) and a "
+        "The default with what an offline renderer can add: the 2nd, 3rd and 4th surface hits "
+        "along each pixel's ray with their facing (`depth2` to `depth4`, `facing2` to "
+        "`facing4`, as the Blender node's default `hidden_surfaces` renders them) and a "
         "%d-pixel guard band around the frame (overscan), rendered by the add-on's helper render "
         "(`scripts/blender/benchmark_layers.py`: Cycles, 1 sample per pixel) on the reference's "
         "pixel grid; as the add-on does, a hit not behind the reference's depth (on a "
         "silhouette the helper's one sample can see the nearer surface) is dropped and the "
         "later ones move up. Each cell: RMSE / band / edge RMSE against the same reference as "
         "above; "
-        "the time ratio is the AO computation with 2 extra layers over the default's, the same "
-        "run." % GUARD_BAND,
+        "the time ratio is the AO computation with %d extra layers and the band over the "
+        "default's, the same run." % (GUARD_BAND, EXTRA_LAYERS),
         "",
         layers_table(rows),
         "",
