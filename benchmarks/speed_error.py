@@ -732,7 +732,7 @@ METHOD_NOTES = """## How it is measured
 `scripts/benchmark.sh [--quick] [--out DIR]` (default DIR `build/benchmark`; `--help` for the
 rest) runs `benchmarks/speed_error.py`, which writes `speed_error.csv`, `speed_error.png`,
 `complexity.csv`, `complexity.png` and this page into DIR; `--update-docs` copies them into
-`docs/`. On 2 cores the full run takes about 26 minutes, plus about 40 minutes the first time
+`docs/`. On 2 cores the full run takes about 40 minutes, plus about 65 minutes the first time
 for the reference renders (cached in `build/benchmark_kit`, keyed by the Blender scripts,
 Blender's version and the render settings); `--quick` (3 scenes at 640x360, 256-spp
 references, fewer settings, one run each) about 2 minutes the first time, 40 s after that.
