@@ -91,12 +91,8 @@ LIBRARY_QUICK = [
 ]
 # The default with what an offline renderer can add (ssao_eval --layers): the 2nd to 4th surface
 # hits with their facing, a guard band around the frame, both.
-LAYER_ROWS = [
-    ("hemisphere", "layers=%d" % EXTRA_LAYERS, ["layers=%d" % EXTRA_LAYERS]),
-    ("hemisphere", "band=%d" % GUARD_BAND, ["band=%d" % GUARD_BAND]),
-    ("hemisphere", "layers=%d,band=%d" % (EXTRA_LAYERS, GUARD_BAND),
-     ["layers=%d" % EXTRA_LAYERS, "band=%d" % GUARD_BAND]),
-]
+LAYER_ROWS = [("hemisphere", setting, [setting]) for setting in crops.LAYERED] + [
+    ("hemisphere", ",".join(crops.LAYERED), crops.LAYERED)]
 # The straight ports of the seed tutorials (tests/reference/seed_ports.cpp) and the brute-force
 # ray march (the accuracy floor of any depth-buffer method; only at 640x360, it is slow).
 SEED_ROWS = [("seed-hemisphere", "samples=16", "seed-hemisphere"),
