@@ -147,6 +147,9 @@ SSAO_VECTORIZE bool Frame::search_step(const float* __restrict last,
   // The neighbour's first three hits say whether the surface goes on (later ones rarely do).
   const float* __restrict second = layers;
   const float* __restrict third = layers + (extra_layers > 1 ? plane : 0);
+  // The hit behind the third, to measure a solid the neighbour shows as its third hit (another
+  // hidden instance of it); with two extra layers or fewer, the third again (no match).
+  const float* __restrict fourth = layers + size_t(extra_layers > 2 ? 2 : extra_layers - 1) * plane;
   int walking_on = 0;
   for (int i = 0; i < count; ++i) {
     // & rather than &&: no branch, so the loop vectorises.
@@ -156,11 +159,22 @@ SSAO_VECTORIZE bool Frame::search_step(const float* __restrict last,
     const bool on_third = std::fabs(std::fabs(third[i]) - last[i]) <= reach;
     const bool near = on_visible | on_second | on_third;
     const bool walking = (stopped[i] == 0.0f) & (last[i] > 0.0f) & near;
-    const float thickness = -second[i] - visible[i];
+    // The neighbour shows the solid closed by the hit behind it: as its visible surface, or
+    // hidden as its 2nd or 3rd hit (a front face).
+    const float on_visible_thickness = -second[i] - visible[i];
+    const float on_second_thickness = -third[i] - second[i];
+    const float on_third_thickness = -fourth[i] - third[i];
+    const bool visible_match = on_visible & (visible[i] != kBackground) & (second[i] < 0.0f);
+    const bool second_match = on_second & (second[i] > 0.0f) & (third[i] < 0.0f) &
+                              (second[i] != kBackground) & (extra_layers > 1);
+    const bool third_match = on_third & (third[i] > 0.0f) & (fourth[i] < 0.0f) &
+                             (third[i] != kBackground) & (extra_layers > 2);
+    const float thickness = visible_match  ? on_visible_thickness
+                            : second_match ? on_second_thickness
+                                           : on_third_thickness;
     // A stretch too short to take the reciprocal of (hostile, subnormal depths) says nothing.
     const bool measurable = thickness > 1e-30f;
-    const bool match =
-        walking & on_visible & (visible[i] != kBackground) & (second[i] < 0.0f) & measurable;
+    const bool match = walking & (visible_match | second_match | third_match) & measurable;
     best[i] = match ? std::max(best[i], thickness) : best[i];
     stopped[i] = (walking & !match) ? stopped[i] : 1.0f;
     walking_on |= int(walking & !match);
