@@ -5,7 +5,7 @@
 For each scene of the kit (640x360 unless --size), the window of 0.3 x the frame (192 x 108 px
 at 640x360) where the library's default has
 its largest band error (G(1) - G(6), as ssao_eval's `band`) is cut from: Cycles' AO pass (the
-reference), the default with one layer, the default with the 2nd to 4th hits and the 64 px band,
+reference), the default with one layer, the default with the 2nd to 5th hits and the 64 px band,
 and Cycles' AO pass at 16 spp when the benchmark's sweep has it. Called by speed_error.py
 (OUT/crops.png); runnable alone on a kit:
 
@@ -26,9 +26,9 @@ import OpenImageIO as oiio
 
 REPO_ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 CROP_FRACTION = 0.3  # of the frame's width and height
-# The layers column: the Blender node's defaults, 4 hits (blender_addon/compute.py,
+# The layers column: the Blender node's defaults, 5 hits (blender_addon/compute.py,
 # HITS['PEELED']) and a 64 px guard band. benchmarks/speed_error.py's layers rows use the same.
-EXTRA_LAYERS, GUARD_BAND = 3, 64
+EXTRA_LAYERS, GUARD_BAND = 4, 64
 LAYERED = ["layers=%d" % EXTRA_LAYERS, "band=%d" % GUARD_BAND]
 SCENES = ["contact", "thin", "cavity", "depth_range", "ortho", "heavy"]
 

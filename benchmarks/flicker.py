@@ -20,7 +20,7 @@ A converged render's flicker is its own noise plus the resampling.
 
 prints per scene the RMSE against the reference (mean over the frames) and both flicker
 figures, for libssao (the default, and each --set variant given; with --layers also with the
-2nd to 4th hits and a guard band, as the Blender node's defaults) and for Cycles; then, for a
+2nd to 5th hits and a guard band, as the Blender node's defaults) and for Cycles; then, for a
 box sliding over `contact`'s floor (the camera still), the error where the AO changed, with
 and without the temporal filter: a trail behind a moving object would show there. The renders
 are cached in the kit folder (about 25 min the first time on 2 cores); --update-docs puts the
@@ -345,7 +345,7 @@ SECTION = "## Flicker on camera moves"
 
 LAYERS_TEXT = (
     "`libssao layers + %d px band`: with what the Blender node's helper render adds by default, "
-    "the 2nd, 3rd and 4th surface hits with their facing and a guard band, rendered for each "
+    "the 2nd to 5th surface hits with their facing and a guard band, rendered for each "
     "frame's camera at 1 spp (`scripts/blender/benchmark_layers.py --truck-px`), hits not "
     "behind the frame's depth dropped as `ssao_eval --layers` does, one `ssao.Sequence` over "
     "the frames as the node's animation renders." % LAYERS_BAND)
@@ -408,7 +408,7 @@ def parse_args(argv=None):
     parser.add_argument("--set", action="append", default=[], metavar="NAME=VALUE[,NAME=VALUE]",
                         help="also measure libssao with these settings (repeatable)")
     parser.add_argument("--layers", action="store_true",
-                        help="also measure libssao with the 2nd to 4th hits and a %d px guard "
+                        help="also measure libssao with the 2nd to 5th hits and a %d px guard "
                              "band, as the Blender node's defaults (renders them into the kit, "
                              "1 spp a frame)" % LAYERS_BAND)
     parser.add_argument("--library",

@@ -89,7 +89,7 @@ LIBRARY_QUICK = [
     ("horizon", "quality=medium", ["variant=horizon"]),
     ("sphere", "quality=medium", ["variant=sphere"]),
 ]
-# The default with what an offline renderer can add (ssao_eval --layers): the 2nd to 4th surface
+# The default with what an offline renderer can add (ssao_eval --layers): the 2nd to 5th surface
 # hits with their facing, a guard band around the frame, both.
 LAYER_ROWS = [("hemisphere", setting, [setting]) for setting in crops.LAYERED] + [
     ("hemisphere", ",".join(crops.LAYERED), crops.LAYERED)]
@@ -594,7 +594,7 @@ def layers_table(rows):
         return "(no scene has its layers file)"
     lines.append(["**mean**"] + [error_cell((statistics.mean(column) for column in zip(*means[s])),
                                             bold=True) for s in settings] + [""])
-    return markdown_table(["scene", "one layer (default)", "+ 2nd to 4th hits",
+    return markdown_table(["scene", "one layer (default)", "+ 2nd to %d hits" % (EXTRA_LAYERS + 1),
                            "+ %d px band" % GUARD_BAND, "+ both", "time with layers"], lines)
 
 
@@ -635,9 +635,9 @@ def write_markdown(path, images, args, plan, rows, table, complexity, noise, mac
         "",
         "## Beyond one depth layer",
         "",
-        "The default with what an offline renderer can add: the 2nd, 3rd and 4th surface hits "
-        "along each pixel's ray with their facing (`depth2` to `depth4`, `facing2` to "
-        "`facing4`, as the Blender node's default `hidden_surfaces` renders them) and a "
+        "The default with what an offline renderer can add: the 2nd to %dth surface hits "
+        "along each pixel's ray with their facing (`depth2` to `depth%d`, `facing2` to "
+        "`facing%d`, as the Blender node's default `hidden_surfaces` renders them) and a "
         "%d-pixel guard band around the frame (overscan), rendered by the add-on's helper render "
         "(`scripts/blender/benchmark_layers.py`: Cycles, 1 sample per pixel) on the reference's "
         "pixel grid; as the add-on does, a hit not behind the reference's depth (on a "
@@ -645,7 +645,7 @@ def write_markdown(path, images, args, plan, rows, table, complexity, noise, mac
         "later ones move up. Each cell: RMSE / band / edge RMSE against the same reference as "
         "above; "
         "the time ratio is the AO computation with %d extra layers and the band over the "
-        "default's, the same run." % (GUARD_BAND, EXTRA_LAYERS),
+        "default's, the same run." % ((EXTRA_LAYERS + 1,) * 3 + (GUARD_BAND, EXTRA_LAYERS)),
         "",
         layers_table(rows),
         "",

@@ -37,7 +37,7 @@ MATERIAL_NAME = ".SSAO layers override"
 GROUP_NAME = ".SSAO layers hits"
 # The custom property that marks a holdout object while the helper renders (_Holdouts).
 HOLDOUT_PROPERTY = "ssao_helper_holdout"
-MAX_HITS = 4
+MAX_HITS = 5  # the library reads up to depth5 (docs/api.md)
 # The open-surface test (_hits_group): inside rays per surface, and how far they look (scene
 # units; a closed mesh is met within its own size).
 OPEN_SAMPLES = 1

@@ -111,7 +111,7 @@ class CompositorNodeSSAO(bpy.types.CompositorNodeCustomGroup):
         description="What the AO knows of the surfaces behind the visible ones (a helper render "
                     "with Cycles at 1 sample per pixel, whatever the render engine)",
         items=[('NONE', "None", "The Depth pass only: behind it, the thickness guess"),
-               ('PEELED', "Peeled", "The 2nd, 3rd and 4th surface hit along each pixel's "
+               ('PEELED', "Peeled", "The 2nd to 5th surface hit along each pixel's "
                                     "ray, and whether each is a back face")],
         default=DEFAULT_HIDDEN_SURFACES, update=_on_parameter_changed)
     # The band's width follows the radius unless given in pixels (setting `overscan` gives it;

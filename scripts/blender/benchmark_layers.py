@@ -6,7 +6,7 @@
         --width 640 --height 360 --overscan 64
 
 builds the scene as scripts/blender/benchmark_scenes.py does and writes PREFIX.layers.exr, the
-file scripts/blender/render_layers.py writes (the 2nd to 4th hits with their facing, the 1-spp
+file scripts/blender/render_layers.py writes (the 2nd to 5th hits with their facing, the 1-spp
 Depth and Normal passes, the band as overscan), and PREFIX.layers.json (its render time).
 benchmarks/speed_error.py scores the library with them (ssao_eval --layers). With
 ``--truck-px P``, a frame of the camera move of scripts/blender/benchmark_sequence.py
@@ -28,7 +28,7 @@ import export_cameras  # noqa: E402
 import make_reference_scene as reference  # noqa: E402
 import render_layers  # noqa: E402
 
-HITS = 4  # as the add-on's node (compute.HITS)
+HITS = 5  # as the add-on's node (compute.HITS)
 
 
 def parse_args(argv):

@@ -3,7 +3,7 @@
 `build/bin/ssao` reads without flags (a farm runs this before the CLI):
 
     blender -b --factory-startup SCENE.blend --python scripts/blender/render_layers.py -- \\
-        --output OUT.exr [--hits 4] [--overscan G] [--frame N] [--camera-json CAMERA.json]
+        --output OUT.exr [--hits 5] [--overscan G] [--frame N] [--camera-json CAMERA.json]
     build/bin/ssao OUT.exr --camera CAMERA.json --ao-only -o AO.exr
 
 The render is the add-on's helper render (blender_addon/hidden_surfaces.py: Cycles at 1 sample
@@ -13,7 +13,7 @@ blender_addon/ imported from this repository.
 
 The file's channels, named after the scene's first rendered view layer L (the CLI's contract):
 L.Depth.Z (planar depth, 1e10 where the ray hits nothing), L.Normal.X/Y/Z (world space), and
-for hits k = 2 to 4 L.Depth<k>.Z and L.Facing<k>.V (L.Depth2.Z, L.Facing2.V, ...: depth of
+for hits k = 2 to 5 L.Depth<k>.Z and L.Facing<k>.V (L.Depth2.Z, L.Facing2.V, ...: depth of
 the k-th surface hit along the camera ray, 1e10 when there is none; facing 1 = back face, 0 =
 front face or no hit). 32-bit float, ZIP. With --overscan G the data window is the display
 window (the render's W x H at (0, 0)) grown by G pixels on each side: (-G, -G) to
@@ -48,8 +48,8 @@ def addon_module(name):
 def parse_args(argv):
     parser = argparse.ArgumentParser(prog=PROG, description=__doc__.split("\n\n")[0])
     parser.add_argument("--output", "-o", required=True, help="the multilayer EXR to write")
-    parser.add_argument("--hits", type=int, default=4, choices=(1, 2, 3, 4),
-                        help="surface hits per pixel (1: depth and normal only; default 4, as "
+    parser.add_argument("--hits", type=int, default=5, choices=(1, 2, 3, 4, 5),
+                        help="surface hits per pixel (1: depth and normal only; default 5, as "
                              "the add-on's node)")
     parser.add_argument("--overscan", type=int, default=0, metavar="G",
                         help="guard band in pixels on each side (default 0)")
