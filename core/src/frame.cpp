@@ -136,20 +136,25 @@ SSAO_VECTORIZE void Frame::hidden_last_fronts(const float* layers, size_t plane,
 
 // One step of the search for pixels [0, count) of a row, their neighbours' visible depths and
 // extra hits at `visible`, `layers` (planes `plane` apart). A pixel still walking its surface
-// (not stopped) whose neighbour shows it as its visible surface, closed by a back face as its
-// 2nd hit, takes that solid's thickness if it is the deepest so far, and stops; so does one
-// whose neighbour's ray meets no surface at its depth among its first three hits (the surface
-// ended: beyond lies another one). Returns whether any pixel walks on.
+// (not stopped) whose neighbour shows it as a front face closed by a back face as the next hit
+// (the visible surface and the 2nd hit, or hidden as the 2nd, 3rd or 4th hit: a 5th hit is often
+// a solid the neighbours see only through the same foreground) takes that solid's thickness if
+// it is the deepest so far, and stops; so does one whose neighbour's ray meets no surface at its
+// depth among its hits (the surface ended: beyond lies another one). Returns whether any pixel
+// walks on.
 SSAO_VECTORIZE bool Frame::search_step(const float* __restrict last,
                                        const float* __restrict visible, const float* layers,
                                        size_t plane, int extra_layers, int count, float tolerance,
                                        float* __restrict stopped, float* __restrict best) {
-  // The neighbour's first three hits say whether the surface goes on (later ones rarely do).
-  const float* __restrict second = layers;
-  const float* __restrict third = layers + (extra_layers > 1 ? plane : 0);
-  // The hit behind the third, to measure a solid the neighbour shows as its third hit (another
-  // hidden instance of it); with two extra layers or fewer, the third again (no match).
-  const float* __restrict fourth = layers + size_t(extra_layers > 2 ? 2 : extra_layers - 1) * plane;
+  // Hits 2 to 5; beyond the frame's extra layers, the last one again (it can neither close a
+  // solid nor add a surface).
+  const auto hit_plane = [&](int k) {
+    return layers + size_t(std::max(0, std::min(k, extra_layers - 1))) * plane;
+  };
+  const float* __restrict second = hit_plane(0);
+  const float* __restrict third = hit_plane(1);
+  const float* __restrict fourth = hit_plane(2);
+  const float* __restrict fifth = hit_plane(3);
   int walking_on = 0;
   for (int i = 0; i < count; ++i) {
     // & rather than &&: no branch, so the loop vectorises.
@@ -157,24 +162,26 @@ SSAO_VECTORIZE bool Frame::search_step(const float* __restrict last,
     const bool on_visible = std::fabs(visible[i] - last[i]) <= reach;
     const bool on_second = std::fabs(std::fabs(second[i]) - last[i]) <= reach;
     const bool on_third = std::fabs(std::fabs(third[i]) - last[i]) <= reach;
-    const bool near = on_visible | on_second | on_third;
+    const bool on_fourth = std::fabs(std::fabs(fourth[i]) - last[i]) <= reach;
+    const bool on_fifth = std::fabs(std::fabs(fifth[i]) - last[i]) <= reach;
+    const bool near = on_visible | on_second | on_third | on_fourth | on_fifth;
     const bool walking = (stopped[i] == 0.0f) & (last[i] > 0.0f) & near;
-    // The neighbour shows the solid closed by the hit behind it: as its visible surface, or
-    // hidden as its 2nd or 3rd hit (a front face).
-    const float on_visible_thickness = -second[i] - visible[i];
-    const float on_second_thickness = -third[i] - second[i];
-    const float on_third_thickness = -fourth[i] - third[i];
+    // A front face (positive, not background) on the searched surface, and a back face behind.
     const bool visible_match = on_visible & (visible[i] != kBackground) & (second[i] < 0.0f);
-    const bool second_match = on_second & (second[i] > 0.0f) & (third[i] < 0.0f) &
-                              (second[i] != kBackground) & (extra_layers > 1);
-    const bool third_match = on_third & (third[i] > 0.0f) & (fourth[i] < 0.0f) &
-                             (third[i] != kBackground) & (extra_layers > 2);
-    const float thickness = visible_match  ? on_visible_thickness
-                            : second_match ? on_second_thickness
-                                           : on_third_thickness;
+    const bool second_match = on_second & (second[i] > 0.0f) & (second[i] != kBackground) &
+                              (third[i] < 0.0f) & (extra_layers > 1);
+    const bool third_match = on_third & (third[i] > 0.0f) & (third[i] != kBackground) &
+                             (fourth[i] < 0.0f) & (extra_layers > 2);
+    const bool fourth_match = on_fourth & (fourth[i] > 0.0f) & (fourth[i] != kBackground) &
+                              (fifth[i] < 0.0f) & (extra_layers > 3);
+    const float thickness = visible_match  ? -second[i] - visible[i]
+                            : second_match ? -third[i] - second[i]
+                            : third_match  ? -fourth[i] - third[i]
+                                           : -fifth[i] - fourth[i];
     // A stretch too short to take the reciprocal of (hostile, subnormal depths) says nothing.
     const bool measurable = thickness > 1e-30f;
-    const bool match = walking & (visible_match | second_match | third_match) & measurable;
+    const bool match =
+        walking & (visible_match | second_match | third_match | fourth_match) & measurable;
     best[i] = match ? std::max(best[i], thickness) : best[i];
     stopped[i] = (walking & !match) ? stopped[i] : 1.0f;
     walking_on |= int(walking & !match);

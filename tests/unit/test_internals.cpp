@@ -413,6 +413,63 @@ TEST(Frame, LastThicknessIsMeasuredBesideTheForeground) {
   }
 }
 
+TEST(Frame, LastThicknessIsMeasuredWhereNeighboursSeeTheSolidHiddenToo) {
+  // A row of rays (orthographic: every ray the same chord) through two boxes and a 10 cm slab
+  // behind them. Left of column 10 a ray meets both boxes, so the slab's front is its 5th hit,
+  // the last it knows; from column 10 on only the second box, so the slab is the 3rd hit, closed
+  // by the 4th. The neighbours that see the slab at all see it hidden, never as the visible
+  // surface: the search must walk through the pixels that see it as their 5th hit and measure
+  // it where a neighbour shows it closed, at any depth of the stack.
+  Camera c;
+  c.ortho = true;
+  c.width = 20, c.height = 3;
+  const int w = c.width, h = c.height;
+  const float inf = std::numeric_limits<float>::infinity();
+  std::vector<float> depth(size_t(w) * h), normal(size_t(w) * h * 3, 0.0f);
+  std::vector<std::vector<float>> hits(4, std::vector<float>(size_t(w) * h, inf));
+  std::vector<std::vector<float>> facing(4, std::vector<float>(size_t(w) * h, 0.0f));
+  for (int y = 0; y < h; ++y) {
+    for (int x = 0; x < w; ++x) {
+      const size_t i = size_t(y) * w + x;
+      normal[3 * i + 2] = 1.0f;
+      const std::vector<float> stack = x < 10 ? std::vector<float>{2.0f, 2.1f, 3.0f, 3.1f, 5.0f}
+                                              : std::vector<float>{3.0f, 3.1f, 5.0f, 5.1f};
+      depth[i] = stack[0];
+      for (size_t k = 1; k < stack.size(); ++k) {
+        hits[k - 1][i] = stack[k];
+        facing[k - 1][i] = k % 2 == 1 ? 1.0f : 0.0f;  // back, front, back, front
+      }
+    }
+  }
+  ssao::FrameInputs in;
+  const auto plane = [&](std::vector<float>& v, int channels) {
+    return ssao::ImageView{
+        v.data(), w, h, channels, 4 * std::ptrdiff_t(channels), 4 * std::ptrdiff_t(channels) * w};
+  };
+  in.depth = plane(depth, 1);
+  in.normal = plane(normal, 3);
+  in.world_normals = false;
+  for (int k = 0; k < 4; ++k) {
+    in.layers[k] = plane(hits[k], 1);
+    in.facing[k] = plane(facing[k], 1);
+  }
+  in.extra_layers = 4;
+  ssao::TilePool pool(2);
+  ssao::Progress progress(nullptr, nullptr);
+  ssao::Frame f;
+  f.reset(camera_model(c, w, h), w, h, in.extra_layers);
+  f.build(in, pool, progress);
+  for (int y = 0; y < h; ++y) {
+    // Within kThicknessSearch of column 10, the slab's chord; farther, nothing is known.
+    for (int x = 0; x < 10; ++x) {
+      const float expected = 10 - x <= ssao::Frame::kThicknessSearch ? 0.1f : 0.0f;
+      EXPECT_NEAR(f.last_thickness(x, y), expected, 1e-5f) << x << ", " << y;
+    }
+    // The slab is closed where it is the 3rd hit: no last front to measure.
+    for (int x = 10; x < w; ++x) EXPECT_EQ(f.last_thickness(x, y), 0.0f) << x << ", " << y;
+  }
+}
+
 TEST(FastPath, EveryVariantMatchesItsScalarReference) {
   struct Case {
     const char* name;
