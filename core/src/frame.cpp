@@ -146,8 +146,9 @@ SSAO_VECTORIZE bool Frame::search_step(const float* __restrict last,
                                        const float* __restrict visible, const float* layers,
                                        size_t plane, int extra_layers, int count, float tolerance,
                                        float* __restrict stopped, float* __restrict best) {
-  // Hits 2 to 5; beyond the frame's extra layers, the last one again (it can neither close a
-  // solid nor add a surface).
+  // Hits 2 to 5; beyond the frame's extra layers, the last one again: it can neither add a
+  // surface nor close a solid (a hit and the same hit behind it cannot be a front face and a
+  // back face), so no match needs to know how many layers there are.
   const auto hit_plane = [&](int k) {
     return layers + size_t(std::max(0, std::min(k, extra_layers - 1))) * plane;
   };
@@ -168,12 +169,12 @@ SSAO_VECTORIZE bool Frame::search_step(const float* __restrict last,
     const bool walking = (stopped[i] == 0.0f) & (last[i] > 0.0f) & near;
     // A front face (positive, not background) on the searched surface, and a back face behind.
     const bool visible_match = on_visible & (visible[i] != kBackground) & (second[i] < 0.0f);
-    const bool second_match = on_second & (second[i] > 0.0f) & (second[i] != kBackground) &
-                              (third[i] < 0.0f) & (extra_layers > 1);
-    const bool third_match = on_third & (third[i] > 0.0f) & (third[i] != kBackground) &
-                             (fourth[i] < 0.0f) & (extra_layers > 2);
-    const bool fourth_match = on_fourth & (fourth[i] > 0.0f) & (fourth[i] != kBackground) &
-                              (fifth[i] < 0.0f) & (extra_layers > 3);
+    const bool second_match =
+        on_second & (second[i] > 0.0f) & (second[i] != kBackground) & (third[i] < 0.0f);
+    const bool third_match =
+        on_third & (third[i] > 0.0f) & (third[i] != kBackground) & (fourth[i] < 0.0f);
+    const bool fourth_match =
+        on_fourth & (fourth[i] > 0.0f) & (fourth[i] != kBackground) & (fifth[i] < 0.0f);
     const float thickness = visible_match  ? -second[i] - visible[i]
                             : second_match ? -third[i] - second[i]
                             : third_match  ? -fourth[i] - third[i]
