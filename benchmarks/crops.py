@@ -94,8 +94,13 @@ def library_ao(args, reference, radius, settings, layers=None, library_dir=None)
         return read_channel(out, "AO")
 
 
-def find(pattern):
+def find(pattern, newest=False):
+    """The first folder matching `pattern` by name, or with newest the last one written: a kit
+    keeps the layers of earlier sources beside the current ones (speed_error.kit_layers keys
+    them by their sources), and the benchmark has just written the current one."""
     found = sorted(p for p in glob.glob(pattern) if not p.endswith(".partial"))
+    if newest:
+        found.sort(key=os.path.getmtime, reverse=True)
     return found[0] if found else None
 
 
@@ -108,7 +113,8 @@ def scene_columns(args, scene):
     with open(reference + ".json", encoding="utf-8") as f:
         settings = json.load(f)
     radius = settings["ao_distance"]
-    layers_folder = find(os.path.join(args.kit, "%s@%s-layers-*" % (scene, args.size)))
+    layers_folder = find(os.path.join(args.kit, "%s@%s-layers-*" % (scene, args.size)),
+                         newest=True)
     layers = os.path.join(layers_folder, "ref.layers.exr") if layers_folder else None
     truth = read_channel(reference + ".exr", "AO.R")
     depth = read_channel(reference + ".exr", "Depth.Z")
