@@ -74,7 +74,7 @@ MAX_BAND = 1024
 # 1.2e-6 between Cycles' Depth pass and the helper's; docs/blender.md).
 SAME_SURFACE = 1e-4
 # hidden_surfaces -> surface hits per pixel the helper render records.
-HITS = {'NONE': 1, 'PEELED': 5}
+HITS = {'NONE': 1, 'PEELED': hidden_surfaces.MAX_HITS}
 
 HELPER_SCENE_PREFIX = ".SSAO recomposite "  # recomposite.py's hidden scenes
 

@@ -28,7 +28,7 @@ import export_cameras  # noqa: E402
 import make_reference_scene as reference  # noqa: E402
 import render_layers  # noqa: E402
 
-HITS = 5  # as the add-on's node (compute.HITS)
+HITS = render_layers.addon_module("hidden_surfaces").MAX_HITS  # as the add-on's node
 
 
 def parse_args(argv):
