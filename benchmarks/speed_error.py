@@ -594,7 +594,7 @@ def layers_table(rows):
         return "(no scene has its layers file)"
     lines.append(["**mean**"] + [error_cell((statistics.mean(column) for column in zip(*means[s])),
                                             bold=True) for s in settings] + [""])
-    return markdown_table(["scene", "one layer (default)", "+ 2nd to %d hits" % (EXTRA_LAYERS + 1),
+    return markdown_table(["scene", "one layer (default)", "+ 2nd to %dth hits" % (EXTRA_LAYERS + 1),
                            "+ %d px band" % GUARD_BAND, "+ both", "time with layers"], lines)
 
 
