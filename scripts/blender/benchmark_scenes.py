@@ -133,26 +133,38 @@ def layout_cavity(scene, mat):
     reference.add_quad(scene, "LeftWall", [(-2.5, -6.0, 0.0), (-2.5, 2.0, 0.0),
                                            (-2.5, 2.0, 2.6), (-2.5, -6.0, 2.6)], mat)
     # A bookcase in the corner: 2 cm boards, 5 shelves of 36 cm, a divider, 35 cm deep cells,
-    # open at the back (the wall closes it).
+    # open at the back (the wall closes it). No two boards overlap: a ray tracer's rays leaving
+    # a face that lies inside another coplanar face hit it at once, which drew false dark
+    # stripes on the sides' outer faces and along the front edges where the shelves used to
+    # run through the sides and the divider.
     x0, x1, y0, y1, top = -2.48, -0.88, 1.63, 1.98, 1.82
     board = 0.02
-    for k, x in enumerate((x0 + board / 2, x1 - board / 2, (x0 + x1) / 2)):
+    middle = (x0 + x1) / 2
+    for k, x in enumerate((x0 + board / 2, x1 - board / 2, middle)):
         reference.add_box(scene, "Side%d" % k, (board, y1 - y0, top), (x, (y0 + y1) / 2, top / 2),
                           mat)
+    # Each shelf in two halves, between a side and the divider.
     for k in range(6):
         z = board / 2 + k * (top - board) / 5
-        reference.add_box(scene, "Shelf%d" % k, (x1 - x0, y1 - y0, board),
-                          (0.5 * (x0 + x1), 0.5 * (y0 + y1), z), mat)
+        for half, (left, right) in enumerate(((x0 + board, middle - board / 2),
+                                              (middle + board / 2, x1 - board))):
+            reference.add_box(scene, "Shelf%d%s" % (k, "ab"[half]), (right - left, y1 - y0, board),
+                              (0.5 * (left + right), 0.5 * (y0 + y1), z), mat)
     # Boxes standing in two cells.
     reference.add_box(scene, "Book0", (0.25, 0.25, 0.22), (-2.2, 1.85, 0.13), mat)
     reference.add_box(scene, "Book1", (0.2, 0.3, 0.3), (-1.15, 1.8, 0.527), mat)
-    # An open crate on the floor: five 2 cm sides, open towards the camera's side (+X).
+    # An open crate on the floor, s on a side: bottom and top whole, between them the back,
+    # the front and one side (open towards the camera's side, +X), 2 cm boards that abut.
     cx, cy, s = 0.3, 0.9, 0.6
+    inner = s - 2 * board
     reference.add_box(scene, "CrateBottom", (s, s, board), (cx, cy, board / 2), mat)
-    reference.add_box(scene, "CrateBack", (s, board, s), (cx, cy + s / 2, s / 2), mat)
-    reference.add_box(scene, "CrateFront", (s, board, s), (cx, cy - s / 2, s / 2), mat)
-    reference.add_box(scene, "CrateSide", (board, s, s), (cx - s / 2, cy, s / 2), mat)
     reference.add_box(scene, "CrateTop", (s, s, board), (cx, cy, s - board / 2), mat)
+    reference.add_box(scene, "CrateBack", (s, board, inner), (cx, cy + (s - board) / 2, s / 2),
+                      mat)
+    reference.add_box(scene, "CrateFront", (s, board, inner), (cx, cy - (s - board) / 2, s / 2),
+                      mat)
+    reference.add_box(scene, "CrateSide", (board, s - 2 * board, inner),
+                      (cx - (s - board) / 2, cy, s / 2), mat)
     reference.add_sphere(scene, "Ball", 0.2, (cx, cy, 0.2 + board), mat)
     return {"kind": "persp", "ao_distance": 0.5, "location": (2.2, -2.6, 1.5),
             "target": (-1.2, 1.4, 0.7)}
