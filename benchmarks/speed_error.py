@@ -20,6 +20,7 @@ Stages (each prints a line as it goes):
    OUT/performance.md, and per scene the equal-error speed-up over Cycles on stdout.
 """
 import argparse
+import ast
 import csv
 import hashlib
 import json
@@ -170,11 +171,34 @@ def blender_command(blender, script, arguments):
 # ---------------------------------------------------------------------------------------------
 # 1. The kit
 
-def kit_key(blender_version, arguments, sources=KIT_SCRIPTS):
+def scene_source(text, scene):
+    """The part of the scenes script (KIT_SCRIPTS[0]) that a render of `scene` depends on: the
+    whole text but the other scenes' layout functions and LAYOUTS entries, so that changing or
+    adding one scene re-renders that scene alone (a full kit takes about 80 minutes)."""
+    lines = text.splitlines(keepends=True)
+    drop = set()
+    for node in ast.parse(text).body:
+        if (isinstance(node, ast.FunctionDef) and node.name.startswith("layout_") and
+                node.name != "layout_" + scene):
+            drop.update(range(node.lineno - 1, node.end_lineno))
+        elif (isinstance(node, ast.Assign) and isinstance(node.value, ast.Dict) and
+              any(isinstance(t, ast.Name) and t.id == "LAYOUTS" for t in node.targets)):
+            for key, value in zip(node.value.keys, node.value.values):
+                if not (isinstance(key, ast.Constant) and key.value == scene):
+                    drop.update(range(key.lineno - 1, value.end_lineno))
+    return "".join(line for k, line in enumerate(lines) if k not in drop)
+
+
+def kit_key(blender_version, arguments, sources, scene):
+    """The cache key of a kit render of `scene`: what its pixels depend on (the sources, with
+    only `scene`'s part of the scenes script, Blender's version and the arguments)."""
     digest = hashlib.sha256()
     for path in sources:
-        with open(path, "rb") as f:
-            digest.update(f.read())
+        with open(path, encoding="utf-8") as f:
+            text = f.read()
+        if path == KIT_SCRIPTS[0]:
+            text = scene_source(text, scene)
+        digest.update(text.encode())
     digest.update(blender_version.encode())
     digest.update(" ".join(arguments).encode())
     return digest.hexdigest()[:12]
@@ -200,7 +224,7 @@ def kit_render(args, blender_version, scene, size, samples, seed=1, border=None,
         move_label = "-move" + move.replace(",", "_")
     # The key leaves out the thread count: it changes the render's speed, not its pixels.
     name = "%s-%ds%d%s%s-%s" % (label(scene, size), samples, seed, "-part" if border else "",
-                                move_label, kit_key(blender_version, arguments, sources))
+                                move_label, kit_key(blender_version, arguments, sources, scene))
     folder = os.path.join(args.kit, name)
     prefix = os.path.join(folder, "ref")
     if os.path.isfile(prefix + ".json"):
@@ -232,7 +256,7 @@ def kit_layers(args, blender_version, scene, size, band=GUARD_BAND, truck_px=Non
         arguments += ["--truck-px", repr(float(truck_px))]
         sources, move_label = LAYERS_SOURCES + [SEQUENCE_SCRIPT], "-truck%g" % truck_px
     name = "%s-layers%s-%s" % (label(scene, size), move_label,
-                               kit_key(blender_version, arguments, sources))
+                               kit_key(blender_version, arguments, sources, scene))
     folder = os.path.join(args.kit, name)
     path = os.path.join(folder, "ref.layers.exr")
     if os.path.isfile(path):

@@ -157,6 +157,37 @@ class QuickRunTest(unittest.TestCase):
         self.assertNotIn("kit: rendering", proc.stdout)
 
 
+class KitKeyTest(unittest.TestCase):
+    """A kit render's key covers its own scene's layout, not the others' (editing one scene
+    re-renders that scene alone)."""
+
+    def setUp(self):
+        with open(speed_error.KIT_SCRIPTS[0], encoding="utf-8") as f:
+            self.text = f.read()
+
+    def test_editing_a_layout_changes_only_its_scene(self):
+        edited = self.text.replace('"Post%02d" % i, (0.05,', '"Post%02d" % i, (0.06,')
+        self.assertNotEqual(edited, self.text)  # the thin fence's posts
+        for scene in ("contact", "thin", "cavity", "depth_range", "ortho", "heavy"):
+            same = speed_error.scene_source(self.text, scene) == \
+                speed_error.scene_source(edited, scene)
+            self.assertEqual(same, scene != "thin", scene)
+
+    def test_shared_code_changes_every_scene(self):
+        edited = self.text.replace("def add_floor_and_wall(", "def add_floor_and_wall_(")
+        self.assertNotEqual(edited, self.text)
+        for scene in ("contact", "cavity"):
+            self.assertNotEqual(speed_error.scene_source(self.text, scene),
+                                speed_error.scene_source(edited, scene))
+
+    def test_a_scene_keeps_its_layout_and_entry(self):
+        text = speed_error.scene_source(self.text, "cavity")
+        self.assertIn("def layout_cavity(", text)
+        self.assertIn('"cavity": layout_cavity', text)
+        self.assertNotIn("def layout_thin(", text)
+        self.assertNotIn('"thin": layout_thin', text)
+
+
 class UsageTest(unittest.TestCase):
     def test_bad_size(self):
         proc = run_benchmark("--size", "3x3", "--out", os.path.join(OPTIONS["scratch"], "bad"))
