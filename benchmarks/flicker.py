@@ -197,6 +197,17 @@ def merged_with_band(band_plane, frame_plane, band):
     return out
 
 
+def hits_behind(depth, hit_planes, facing_planes):
+    """The extra hits (H x W x N) behind `depth`, nearest first, and their facing: a hit not
+    behind the depth the library is given is dropped and the later ones move up, as the Blender
+    add-on and ssao_eval --layers do; the places left empty are "no hit" (NO_HIT, facing 0)."""
+    hits, facing = np.stack(hit_planes, axis=-1), np.stack(facing_planes, axis=-1)
+    behind = hits > depth[:, :, None]
+    order = np.argsort(np.where(behind, hits, np.inf), axis=-1, kind="stable")
+    return (np.take_along_axis(np.where(behind, hits, NO_HIT), order, axis=-1),
+            np.take_along_axis(np.where(behind, facing, 0.0), order, axis=-1))
+
+
 def layered_sequence(args, blender_version, scene, prefixes):
     """libssao's AO of every frame of a move with the hidden surface hits and a LAYERS_BAND px
     guard band (what the Blender node's helper render adds by default: benchmark_layers.py on
@@ -222,13 +233,7 @@ def layered_sequence(args, blender_version, scene, prefixes):
         big_depth = merged_with_band(band_planes[0], depth, LAYERS_BAND)
         normals = np.stack([merged_with_band(b, f, LAYERS_BAND)
                             for b, f in zip(band_planes[1:4], (nx, ny, nz))], axis=-1)
-        # Hits behind the depth, nearest first; the places left empty are "no hit".
-        hits = np.stack(band_planes[4::2], axis=-1)
-        facing = np.stack(band_planes[5::2], axis=-1)
-        behind = hits > big_depth[:, :, None]
-        order = np.argsort(np.where(behind, hits, np.inf), axis=-1, kind="stable")
-        hits = np.take_along_axis(np.where(behind, hits, NO_HIT), order, axis=-1)
-        facing = np.take_along_axis(np.where(behind, facing, 0.0), order, axis=-1)
+        hits, facing = hits_behind(big_depth, band_planes[4::2], band_planes[5::2])
         with open(prefix + ".camera.json", encoding="utf-8") as f:
             camera = json.load(f)
         ao = shot.ambient_occlusion(

@@ -4,18 +4,19 @@
 march through a kit scene's layers file, scored against the scene's Cycles AO pass.
 
     benchmarks/layered_oracle.py KIT_FOLDER/ref LAYERS.exr [--rays 256] [--steps 48]
-        [--stride 4] [--thickness 0.5] [--one-layer] [--compare AO.exr ...] [--write-ao OUT.exr]
+        [--stride 4] [--thickness 0.5] [--one-layer] [--compare AO.exr ...]
+        [--write-ao OUT.exr]
 
-For every stride-th pixel (in x and y) that shows geometry (depth below 0.9 x clip_end), `rays` cosine-weighted rays of the
-scene's AO distance (ref.json's ao_distance) leave the surface (depth and Normal pass of
-ref.exr) and each is marched in `steps` jittered steps. A step is occupied where its pixel's
-ray is inside a solid: from a front face to the back face that closes it, the hits as
-LAYERS.exr holds them (the guard band included; hits not behind the frame's depth dropped and
-the later ones moved up, as the Blender add-on does); behind a last front face `thickness`
-(a fraction of the AO distance) deep; in front of the visible surface or behind a back face,
-free. A ray is blocked by its first occupied step, as Cycles' binary AO rays are. With
---one-layer only the frame's depth is known (no band, no hits behind): behind the visible
-surface is solid for `thickness`.
+For every stride-th pixel (in x and y) that shows geometry (depth below 0.9 x clip_end),
+`rays` cosine-weighted rays of the scene's AO distance (ref.json's ao_distance) leave the
+surface (depth and Normal pass of ref.exr) and each is marched in `steps` jittered steps.
+A step is occupied where its pixel's ray is inside a solid: from a front face to the back face
+that closes it, the hits as LAYERS.exr holds them (the guard band included; hits not behind
+the frame's depth dropped and the later ones moved up, as the Blender add-on does); behind a
+last front face `thickness` (a fraction of the AO distance) deep; in front of the visible
+surface or behind a back face, free. A ray is blocked by its first occupied step, as Cycles'
+binary AO rays are. With --one-layer only the frame's depth is known (no band, no hits
+behind): behind the visible surface is solid for `thickness`.
 
 Prints the march's RMSE against the reference AO over those pixels, raw and with its own noise
 (binary rays: mean p(1 - p) / (rays - 1)) taken out, its bias, and the same pixels' RMSE and
@@ -33,14 +34,14 @@ import sys
 import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-import flicker  # noqa: E402  (read_channels, View: the kit's camera JSON and EXR channels)
-
-HITS = 5  # the layers file's Depth, Depth2 .. Depth5 (the Blender node's 'PEELED')
+import flicker  # noqa: E402  (the kit's camera JSON, EXR channels and layers files)
 
 
 def parse_args(argv=None):
-    parser = argparse.ArgumentParser(prog="layered_oracle.py", description=__doc__.split("\n\n")[0])
-    parser.add_argument("reference", help="the kit render's prefix (PREFIX.exr, .camera.json, .json)")
+    parser = argparse.ArgumentParser(prog="layered_oracle.py",
+                                     description=__doc__.split("\n\n")[0])
+    parser.add_argument("reference",
+                        help="the kit render's prefix (PREFIX.exr, .camera.json, .json)")
     parser.add_argument("layers", help="its layers file (scripts/blender/benchmark_layers.py)")
     parser.add_argument("--rays", type=int, default=256)
     parser.add_argument("--steps", type=int, default=48)
@@ -59,29 +60,25 @@ def parse_args(argv=None):
 
 
 def read_layers(path, depth, one_layer):
-    """The layers file's visible depth (the frame's own inside it), its deeper hits (NO_HIT where
-    none) and whether each is a back face, on the file's whole window; and the band's width."""
+    """The layers file's visible depth (the frame's own inside it), its deeper hits behind that
+    depth (flicker.hits_behind: NO_HIT where none) and whether each is a back face, on the
+    file's whole window; and the band's width."""
     import OpenImageIO as oiio
     image = oiio.ImageInput.open(path)
     if image is None:
         raise SystemExit("layered_oracle.py: cannot open %s: %s" % (path, oiio.geterror()))
     band = -image.spec().x
     image.close()
-    planes = flicker.read_channels(path, ["Depth.Z"] + ["Depth%d.Z" % k for k in range(2, HITS + 1)]
-                                   + ["Facing%d.V" % k for k in range(2, HITS + 1)])
-    height, width = depth.shape
-    visible = planes[0].copy()
-    visible[band:band + height, band:band + width] = depth
-    hits = np.stack(planes[1:HITS], -1)
-    back = np.stack(planes[HITS:], -1) > 0.5
-    behind = hits > visible[..., None] * (1 + 1e-6)
-    order = np.argsort(~behind, axis=-1, kind="stable")
-    hits = np.take_along_axis(np.where(behind, hits, flicker.NO_HIT), order, -1)
-    back = np.take_along_axis(back & behind, order, -1)
+    extra = range(2, flicker.hit_count(path) + 1)
+    planes = flicker.read_channels(path, ["Depth.Z"] + ["Depth%d.Z" % k for k in extra] +
+                                   ["Facing%d.V" % k for k in extra])
+    visible = flicker.merged_with_band(planes[0], depth, band)
+    hits, facing = flicker.hits_behind(visible, planes[1:len(extra) + 1], planes[len(extra) + 1:])
+    back = facing > 0.5
     if one_layer:
         hits[:] = flicker.NO_HIT
         inside = np.zeros(visible.shape, bool)
-        inside[band:band + height, band:band + width] = True
+        inside[band:band + depth.shape[0], band:band + depth.shape[1]] = True
         visible = np.where(inside, visible, flicker.NO_HIT)
     return visible, hits, back, band
 

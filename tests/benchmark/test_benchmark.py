@@ -168,7 +168,7 @@ class KitKeyTest(unittest.TestCase):
     def test_editing_a_layout_changes_only_its_scene(self):
         edited = self.text.replace('"Post%02d" % i, (0.05,', '"Post%02d" % i, (0.06,')
         self.assertNotEqual(edited, self.text)  # the thin fence's posts
-        for scene in ("contact", "thin", "cavity", "depth_range", "ortho", "heavy"):
+        for scene in speed_error.crops.SCENES:
             same = speed_error.scene_source(self.text, scene) == \
                 speed_error.scene_source(edited, scene)
             self.assertEqual(same, scene != "thin", scene)
