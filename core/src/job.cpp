@@ -542,6 +542,7 @@ void Job::run() {
   const float radius = static_cast<float>(v.get_float("radius"));
   const Denoiser denoiser(seen, denoise_mode(v.get_string("denoise")), radius);
   const float filter_weight = pixel_filter_weight(v.get_float("pixel_filter"));
+  const bool edges_from_beauty = v.get_string("edge_coverage") == "beauty" && beauty_.attached();
   // A frame of a sequence (frame >= 0) averages the frames before it that this job computed.
   const int frame_number = v.get_int("frame");
   temporal_.begin(frame_number, frame_number >= 0 ? v.get_int("temporal_frames") : 1, camera,
@@ -584,11 +585,23 @@ void Job::run() {
     };
     if (sky) {
       std::fill(denoised.begin(), denoised.end(), 1.0f);
-    } else if (filter_weight > 0.0f) {
+    } else if (filter_weight > 0.0f || edges_from_beauty) {
       const Tile around = pixel_filter_source(frame, t);
       ScratchVector<float> resolved(size_t(around.x1 - around.x0) * size_t(around.y1 - around.y0));
       resolve(around, resolved.data());
-      pixel_filter(frame, around, resolved.data(), t, filter_weight, denoised.data());
+      if (filter_weight > 0.0f) {
+        pixel_filter(frame, around, resolved.data(), t, filter_weight, denoised.data());
+      } else {
+        for (int y = t.y0; y < t.y1; ++y) {
+          std::copy_n(resolved.data() + size_t(y - around.y0) * size_t(around.x1 - around.x0) +
+                          (t.x0 - around.x0),
+                      t.x1 - t.x0, denoised.data() + size_t(y - t.y0) * size_t(t.x1 - t.x0));
+        }
+      }
+      if (edges_from_beauty) {
+        mix_edges_by_beauty(frame, beauty_, dx, dy, around, resolved.data(), t, filter_weight,
+                            denoised.data());
+      }
     } else {
       resolve(t, denoised.data());
     }

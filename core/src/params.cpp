@@ -144,6 +144,14 @@ const std::vector<Param>& params() {
                    "space of the normal image; world needs camera_to_world"),
       float_param(kInput, "background_depth", 1e9, 0.0, kInf, "scene units",
                   "depths at or beyond this are background (Blender writes 1e10)"),
+      string_param(kInput, "edge_coverage", "none", "none|beauty",
+                   "beauty: at a depth edge, where the \"beauty\" image is attached and the two "
+                   "surfaces' colours differ enough, the pixel's AO is the two surfaces' AO "
+                   "(each through the pixel filter) mixed by the share of the pixel each covers, "
+                   "read from the anti-aliased beauty, as a renderer's AO pass mixes them (the "
+                   "Depth pass holds one surface); elsewhere, and without a beauty, the pixel "
+                   "filter alone; not for a beauty whose edges are not the depth's (depth of "
+                   "field or motion blur rendered into it). none: the pixel filter alone"),
       // --- camera (Blender's bpy.types.Camera names) ---
       string_param(kCamera, "camera_type", "PERSP", "PERSP|ORTHO",
                    "perspective or orthographic camera"),

@@ -90,4 +90,141 @@ void pixel_filter(const Frame& frame, const Tile& around, const float* source, c
   }
 }
 
+namespace {
+
+// Two depths of different surfaces: a jump of more than kEdgeDepthJump of the nearer.
+bool depth_jump(float a, float b) { return std::fabs(a - b) > kEdgeDepthJump * std::min(a, b); }
+
+// The beauty's colour of frame pixel (x, y) into rgb, if that pixel is in the beauty and finite.
+bool beauty_colour(const ImageView& beauty, int x, int y, float* rgb) {
+  if (x < 0 || y < 0 || x >= beauty.width || y >= beauty.height) return false;
+  const float* p = beauty.pixel(x, y);
+  for (int c = 0; c < 3; ++c) {
+    rgb[c] = p[beauty.channels >= 3 ? c : 0];
+    if (!std::isfinite(rgb[c])) return false;
+  }
+  return true;
+}
+
+float dot3(const float* a, const float* b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+
+// 1 where pixel i of a row has a depth jump to its right neighbour or to the pixel below it
+// (`below`: the next row, or the row itself on the last), else 0; background pixels read
+// Frame::kBackground, so a jump to or from the sky is flagged too (the caller tells them
+// apart). `depth` has count + 1 readable values. A plain loop the compiler vectorises: most
+// pixels are on no edge, and this is what finds the few that are.
+SSAO_VECTORIZE void jump_row(const float* __restrict depth, const float* __restrict below,
+                             int count, unsigned char* __restrict flags) {
+  for (int i = 0; i < count; ++i) {
+    const float d = depth[i], right = depth[i + 1], down = below[i];
+    const bool across = std::fabs(d - right) > kEdgeDepthJump * std::min(d, right);
+    const bool under = std::fabs(d - down) > kEdgeDepthJump * std::min(d, down);
+    flags[i] = (across || under) ? 1 : 0;
+  }
+}
+
+}  // namespace
+
+void mix_edges_by_beauty(const Frame& frame, const ImageView& beauty, int dx, int dy,
+                         const Tile& around, const float* source, const Tile& t, float weight,
+                         float* out) {
+  const int source_width = around.x1 - around.x0, width = t.x1 - t.x0;
+  const auto inside = [&](int x, int y) {
+    return x >= 0 && y >= 0 && x < frame.width() && y < frame.height() && frame.is_geometry(x, y);
+  };
+  static constexpr int kSteps[4][2] = {{1, 0}, {-1, 0}, {0, 1}, {0, -1}};
+  // Jumps to the right and below of the pixels in rows t.y0 - 1 .. t.y1 - 1 and columns
+  // t.x0 - 1 .. t.x1 - 1 (clipped to the frame): a pixel is a candidate when it, its left or its
+  // upper neighbour has a flag.
+  const int x_first = std::max(t.x0 - 1, 0), y_first = std::max(t.y0 - 1, 0);
+  const int columns = t.x1 - x_first, rows = t.y1 - y_first;
+  // The frame's last column has no right neighbour: its flag is for the pixel below alone.
+  const bool last_column = t.x1 == frame.width();
+  ScratchVector<unsigned char> flags(size_t(columns) * size_t(rows), 0);
+  for (int r = 0; r < rows; ++r) {
+    const int y = y_first + r;
+    const float* row = frame.depth_plane() + frame.index(x_first, y);
+    const float* below =
+        frame.depth_plane() + frame.index(x_first, std::min(y + 1, frame.height() - 1));
+    unsigned char* out_flags = flags.data() + size_t(r) * size_t(columns);
+    jump_row(row, below, columns - (last_column ? 1 : 0), out_flags);
+    if (last_column) {
+      out_flags[columns - 1] = depth_jump(row[columns - 1], below[columns - 1]) ? 1 : 0;
+    }
+  }
+  const auto flagged = [&](int x, int y) {
+    return x >= x_first && y >= y_first &&
+           flags[size_t(y - y_first) * size_t(columns) + size_t(x - x_first)] != 0;
+  };
+  for (int y = t.y0; y < t.y1; ++y) {
+    for (int x = t.x0; x < t.x1; ++x) {
+      if (!flagged(x, y) && !flagged(x - 1, y) && !flagged(x, y - 1)) continue;
+      if (!frame.is_geometry(x, y)) continue;
+      const float depth = frame.depth(x, y);
+      // The neighbour across the largest jump.
+      int sx = 0, sy = 0;
+      float largest = 0.0f;
+      for (const auto& s : kSteps) {
+        if (!inside(x + s[0], y + s[1])) continue;
+        const float other = frame.depth(x + s[0], y + s[1]);
+        const float jump = std::fabs(depth - other) / std::min(depth, other);
+        if (depth_jump(depth, other) && jump > largest) largest = jump, sx = s[0], sy = s[1];
+      }
+      if (largest == 0.0f) continue;
+      const int nx = x + sx, ny = y + sy;
+      // The pixels beyond either side must lie on the same surfaces as p and n.
+      if (!inside(x - sx, y - sy) || !inside(nx + sx, ny + sy) ||
+          depth_jump(depth, frame.depth(x - sx, y - sy)) ||
+          depth_jump(frame.depth(nx, ny), frame.depth(nx + sx, ny + sy))) {
+        continue;
+      }
+      float own[3], other[3], mixed[3];
+      if (!beauty_colour(beauty, x - sx - dx, y - sy - dy, own) ||
+          !beauty_colour(beauty, nx + sx - dx, ny + sy - dy, other) ||
+          !beauty_colour(beauty, x - dx, y - dy, mixed)) {
+        continue;
+      }
+      float difference[3], from_other[3];
+      for (int c = 0; c < 3; ++c) {
+        difference[c] = own[c] - other[c];
+        from_other[c] = mixed[c] - other[c];
+      }
+      const float contrast = dot3(difference, difference);
+      const float larger = std::max(dot3(own, own), dot3(other, other));
+      if (!(contrast > 0.0f) || contrast < kEdgeColourContrast * kEdgeColourContrast * larger) {
+        continue;
+      }
+      const float beta = std::min(1.0f, std::max(0.0f, dot3(from_other, difference) / contrast));
+      if (!std::isfinite(beta)) continue;
+      // Each surface's AO through the pixel filter, over the pixels around p on that surface
+      // (without the filter, p's and n's own).
+      const float side = weight, centre = 1.0f - 2.0f * weight;
+      if (!(weight > 0.0f)) {
+        out[size_t(y - t.y0) * width + (x - t.x0)] =
+            beta * source[size_t(y - around.y0) * source_width + (x - around.x0)] +
+            (1.0f - beta) * source[size_t(ny - around.y0) * source_width + (nx - around.x0)];
+        continue;
+      }
+      float own_sum = 0.0f, own_weight = 0.0f, other_sum = 0.0f, other_weight = 0.0f;
+      const float other_depth = frame.depth(nx, ny);
+      for (int qy = std::max(y - 1, around.y0); qy < std::min(y + 2, around.y1); ++qy) {
+        for (int qx = std::max(x - 1, around.x0); qx < std::min(x + 2, around.x1); ++qx) {
+          if (!frame.is_geometry(qx, qy)) continue;
+          const float w = (qx == x ? centre : side) * (qy == y ? centre : side);
+          const float ao = source[size_t(qy - around.y0) * source_width + (qx - around.x0)];
+          const float d = frame.depth(qx, qy);
+          if (!depth_jump(d, depth)) {
+            own_sum += w * ao, own_weight += w;
+          } else if (!depth_jump(d, other_depth)) {
+            other_sum += w * ao, other_weight += w;
+          }
+        }
+      }
+      if (!(own_weight > 0.0f) || !(other_weight > 0.0f)) continue;
+      out[size_t(y - t.y0) * width + (x - t.x0)] =
+          beta * (own_sum / own_weight) + (1.0f - beta) * (other_sum / other_weight);
+    }
+  }
+}
+
 }  // namespace ssao

@@ -282,6 +282,45 @@ class GoodRunTest(CliTestCase):
         _, ao_only = read_image(self.output)
         np.testing.assert_array_equal(ao_only[:, :, 0], full[:, :, names.index("AO")])
 
+    def test_edge_coverage_reads_the_beauty_at_depth_edges(self):
+        # A red box before a blue wall. The wall's column just left of the box is, in the
+        # beauty, all wall (run "pure") or half box (run "half": the box's edge inside it).
+        # --edge-coverage beauty gives that column the wall's AO alone in the first, half the
+        # box's in the second; the default's pixel filter takes a fixed share of the box. The
+        # wall beside the box is darker than the box's face, so pure < default < half there;
+        # pixels off the box's depth edges do not change.
+        box = np.zeros((HEIGHT, WIDTH), bool)
+        box[BOX_Y[0]:BOX_Y[1], BOX_X[0]:BOX_X[1]] = True
+        column = BOX_X[0] - 1
+        rows = slice(BOX_Y[0] + 2, BOX_Y[1] - 2)
+        runs = {}
+        for name, box_share in (("pure", 0.0), ("half", 0.5), ("default", 0.0)):
+            for c, (wall, red) in zip("RGB", ((0.1, 0.8), (0.2, 0.2), (0.7, 0.1))):
+                plane = np.where(box, red, wall).astype(np.float32)
+                plane[rows, column] = box_share * red + (1 - box_share) * wall
+                self.planes["ViewLayer.Combined." + c] = plane
+            write_exr(self.input, self.planes, BLENDER_CHANNELS)
+            flags = [] if name == "default" else ["--edge-coverage", "beauty"]
+            self.assert_ok(self.run_ssao(*flags))
+            names, out = read_image(self.output)
+            runs[name] = out[:, :, names.index("AO")]
+            os.remove(self.output)
+        pure, half, default = runs["pure"][rows, column], runs["half"][rows, column], \
+            runs["default"][rows, column]
+        self.assertTrue(np.all(pure < default - 0.005), (pure, default))
+        self.assertTrue(np.all(half > default + 0.005), (half, default))
+        edge = np.zeros_like(box)
+        edge[BOX_Y[0] - 1:BOX_Y[1] + 1, BOX_X[0] - 1:BOX_X[1] + 1] = True
+        edge[BOX_Y[0] + 1:BOX_Y[1] - 1, BOX_X[0] + 1:BOX_X[1] - 1] = False
+        np.testing.assert_array_equal(runs["half"][~edge], runs["default"][~edge])
+        # --ao-only attaches no beauty: the flag changes nothing there.
+        self.assert_ok(self.run_ssao("--ao-only", "--edge-coverage", "beauty"))
+        _, with_flag = read_image(self.output)
+        os.remove(self.output)
+        self.assert_ok(self.run_ssao("--ao-only"))
+        _, without = read_image(self.output)
+        np.testing.assert_array_equal(with_flag, without)
+
     def test_without_alpha_writes_rgb_and_ao(self):
         write_exr(self.input, self.planes,
                   [n for n in BLENDER_CHANNELS if n != "ViewLayer.Combined.A"])

@@ -340,6 +340,7 @@ struct Scene {
   std::vector<double> matrix_world;  // camera-to-world, row-major, 16 values
   std::vector<float> depth;          // planar, 1 channel
   std::vector<float> world_normal;   // 3 channels or empty
+  std::vector<float> beauty;         // the Combined pass's R, G, B, or empty
   std::vector<float> truth;          // the AO pass
   std::vector<unsigned char> mask;   // pixels that are scored
   size_t scored = 0;
@@ -480,6 +481,10 @@ Scene load_scene(const Options& o) {
   s.depth = ssao_tools::extract_named_channels(image, {passes.depth}, o.scene);
   if (!passes.normal.empty()) {
     s.world_normal = ssao_tools::extract_named_channels(image, passes.normal, o.scene);
+  }
+  if (passes.beauty.size() >= 3) {
+    s.beauty = ssao_tools::extract_named_channels(
+        image, {passes.beauty[0], passes.beauty[1], passes.beauty[2]}, o.scene);
   }
   s.truth = ssao_tools::extract_channels(image, {ao_index});
 
@@ -707,7 +712,7 @@ ReferenceSettings parse_reference_settings(const std::string& method,
 // Everything the ssao method keeps between runs.
 struct CoreState {
   ssao::api::Job job;
-  std::vector<float> depth, normal;
+  std::vector<float> depth, normal, beauty;
   std::vector<std::vector<float>> layer_depth, layer_facing;
 };
 
@@ -809,6 +814,11 @@ Method make_method(const std::string& name, const std::vector<Setting>& settings
     }
     m.ao->assign(scene->depth.size(), 0.0f);
     job.set_output_window(band > 0, band, band);
+    // The Combined pass, which edge_coverage=beauty reads (the AO is the same without it).
+    if (!scene->beauty.empty()) {
+      state->beauty = scene->beauty;
+      job.set_image("beauty", state->beauty.data(), w, h, 3);
+    }
     job.set_image("ao", m.ao->data(), w, h, 1);
     m.run = [state] { state->job.run(); };
     return m;

@@ -289,34 +289,34 @@ TEST(Analytic, PerspectiveAndOrthographicAgree) {
 // renderer's anti-aliased AO pass mixes the board's and the wall's AO on those pixels where the
 // Depth pass holds one of them; the reference does too: ray-traced AO at 3 x 3 points a pixel,
 // weighted by a Gaussian pixel filter of standard deviation 0.5 px (truncated at 1.5 px).
-TEST(Analytic, PixelFilterMixesBothSurfacesAtEdgesAsASupersampledRender) {
-  const Camera cam;
-  const double radius = 1.0, turn = 20.0 * M_PI / 180.0;
-  const V3 across{std::cos(turn), std::sin(turn), 0}, up{-std::sin(turn), std::cos(turn), 0};
-  const V3 towards{0, 0, 1}, centre{0, 0, -5.15};  // front face at depth 5, the wall at 5.6
-  const Solid board = {{centre + across * 1.2, across},
-                       {centre - across * 1.2, across * -1.0},
-                       {centre + up * 0.6, up},
-                       {centre - up * 0.6, up * -1.0},
-                       {centre + towards * 0.15, towards},
-                       {centre - towards * 0.15, towards * -1.0}};
-  const std::vector<Solid> solids = {board, {{{0, 0, -5.6}, towards}}};
-  Scene s = ray_cast(cam, solids);
-  const auto index = [&](int x, int y) { return size_t(y) * s.width + x; };
-  // Pixels with a depth jump of more than 5 % to a 4-neighbour (both surfaces geometry).
-  std::vector<char> edge(s.depth.size(), 0);
-  for (int y = 1; y + 1 < s.height; ++y) {
-    for (int x = 1; x + 1 < s.width; ++x) {
-      for (const auto& [dx, dy] : {std::pair{1, 0}, {-1, 0}, {0, 1}, {0, -1}}) {
-        const float d = s.depth[index(x, y)], n = s.depth[index(x + dx, y + dy)];
-        if (std::fabs(d - n) > 0.05f * std::min(d, n)) edge[index(x, y)] = 1;
+struct SlantedBoard {
+  SlantedBoard() {
+    const double turn = 20.0 * M_PI / 180.0;
+    const V3 across{std::cos(turn), std::sin(turn), 0}, up{-std::sin(turn), std::cos(turn), 0};
+    const V3 towards{0, 0, 1}, centre{0, 0, -5.15};  // front face at depth 5, the wall at 5.6
+    const Solid board = {{centre + across * 1.2, across},
+                         {centre - across * 1.2, across * -1.0},
+                         {centre + up * 0.6, up},
+                         {centre - up * 0.6, up * -1.0},
+                         {centre + towards * 0.15, towards},
+                         {centre - towards * 0.15, towards * -1.0}};
+    solids = {board, {{{0, 0, -5.6}, towards}}};
+    s = ray_cast(cam, solids);
+    // Pixels with a depth jump of more than 5 % to a 4-neighbour (both surfaces geometry).
+    edge.assign(s.depth.size(), 0);
+    for (int y = 1; y + 1 < s.height; ++y) {
+      for (int x = 1; x + 1 < s.width; ++x) {
+        for (const auto& [dx, dy] : {std::pair{1, 0}, {-1, 0}, {0, 1}, {0, -1}}) {
+          const float d = s.depth[index(x, y)], n = s.depth[index(x + dx, y + dy)];
+          if (std::fabs(d - n) > 0.05f * std::min(d, n)) edge[index(x, y)] = 1;
+        }
       }
     }
+    sub_ao.assign(s.depth.size() * kSub * kSub, -1.0);
   }
-  // Ray-traced AO at sub-pixel point (i + 0.5) / 3 on each axis, computed once.
-  constexpr int kSub = 3;
-  std::vector<double> sub_ao(s.depth.size() * kSub * kSub, -1.0);
-  const auto ao_at = [&](int i, int j) {  // sub-pixel column i, row j
+  size_t index(int x, int y) const { return size_t(y) * s.width + x; }
+  // Ray-traced AO at sub-pixel point (i + 0.5) / 3 on each axis (column i, row j), computed once.
+  double ao_at(int i, int j) {
     double& value = sub_ao[size_t(j) * s.width * kSub + i];
     if (value < 0.0) {
       V3 o, d, normal{0, 0, 0};
@@ -325,54 +325,142 @@ TEST(Analytic, PixelFilterMixesBothSurfacesAtEdgesAsASupersampledRender) {
       value = ray_traced_ao(solids, o + d * t, normal, radius, 144);
     }
     return value;
-  };
-  const double sigma = 0.5;
-  double filtered_sq = 0, point_sq = 0, moved_inside = 0;
-  int edges = 0;
-  const auto point = compute_ao(s, cam, radius, "hemisphere", true, [](Job& j) {
+  }
+  // `at(i, j)` over the sub-pixel points of pixel (x, y) and its 8 neighbours, weighted by a
+  // Gaussian pixel filter of standard deviation 0.5 px: what a renderer's pass holds there.
+  template <class F>
+  double filtered(int x, int y, F&& at) const {
+    constexpr double kSigma = 0.5;
+    double sum = 0, weights = 0;
+    for (int j = (y - 1) * kSub; j < (y + 2) * kSub; ++j) {
+      for (int i = (x - 1) * kSub; i < (x + 2) * kSub; ++i) {
+        const double du = (i + 0.5) / kSub - (x + 0.5), dv = (j + 0.5) / kSub - (y + 0.5);
+        const double w = std::exp(-(du * du + dv * dv) / (2 * kSigma * kSigma));
+        sum += w * at(i, j);
+        weights += w;
+      }
+    }
+    return sum / weights;
+  }
+  // RMSE of `ao` over the edge pixels (2 px from the border) against the supersampled
+  // ray-traced AO through the pixel filter; `count` gets how many there are.
+  double edge_rmse(const std::vector<float>& ao, int& count) {
+    double sum_sq = 0;
+    count = 0;
+    for (int y = 2; y + 2 < s.height; ++y) {
+      for (int x = 2; x + 2 < s.width; ++x) {
+        if (!edge[index(x, y)]) continue;
+        const double reference = filtered(x, y, [&](int i, int j) { return ao_at(i, j); });
+        sum_sq += std::pow(ao[index(x, y)] - reference, 2);
+        ++count;
+      }
+    }
+    return std::sqrt(sum_sq / std::max(count, 1));
+  }
+  static constexpr int kSub = 3;
+  const Camera cam;
+  const double radius = 1.0;
+  std::vector<Solid> solids;
+  Scene s;
+  std::vector<char> edge;
+  std::vector<double> sub_ao;
+};
+
+TEST(Analytic, PixelFilterMixesBothSurfacesAtEdgesAsASupersampledRender) {
+  SlantedBoard b;
+  const Scene& s = b.s;
+  const auto point = compute_ao(b.s, b.cam, b.radius, "hemisphere", true, [](Job& j) {
     j.set("resolution", "full");
     j.set("pixel_filter", 0.0);
   });
-  const auto filtered = compute_ao(s, cam, radius, "hemisphere", true,
+  const auto filtered = compute_ao(b.s, b.cam, b.radius, "hemisphere", true,
                                    [](Job& j) { j.set("resolution", "full"); });  // the default
+  // Away from edges the filter only smooths what is already smooth.
+  double moved_inside = 0;
   for (int y = 2; y + 2 < s.height; ++y) {
     for (int x = 2; x + 2 < s.width; ++x) {
-      if (!edge[index(x, y)]) {
-        // Away from edges the filter only smooths what is already smooth.
-        bool near_edge = false;
-        for (int dy = -1; dy <= 1; ++dy) {
-          for (int dx = -1; dx <= 1; ++dx) near_edge = near_edge || edge[index(x + dx, y + dy)];
-        }
-        if (!near_edge) {
-          moved_inside =
-              std::max(moved_inside, double(std::fabs(filtered[index(x, y)] - point[index(x, y)])));
-        }
-        continue;
+      bool near_edge = false;
+      for (int dy = -1; dy <= 1; ++dy) {
+        for (int dx = -1; dx <= 1; ++dx) near_edge = near_edge || b.edge[b.index(x + dx, y + dy)];
       }
-      double sum = 0, weights = 0;
-      for (int j = (y - 1) * kSub; j < (y + 2) * kSub; ++j) {
-        for (int i = (x - 1) * kSub; i < (x + 2) * kSub; ++i) {
-          const double du = (i + 0.5) / kSub - (x + 0.5), dv = (j + 0.5) / kSub - (y + 0.5);
-          const double w = std::exp(-(du * du + dv * dv) / (2 * sigma * sigma));
-          sum += w * ao_at(i, j);
-          weights += w;
-        }
-      }
-      const double reference = sum / weights;
-      filtered_sq += std::pow(filtered[index(x, y)] - reference, 2);
-      point_sq += std::pow(point[index(x, y)] - reference, 2);
-      ++edges;
+      if (near_edge) continue;
+      const size_t i = b.index(x, y);
+      moved_inside = std::max(moved_inside, double(std::fabs(filtered[i] - point[i])));
     }
   }
+  int edges = 0;
+  const double point_rmse = b.edge_rmse(point, edges);
+  const double filtered_rmse = b.edge_rmse(filtered, edges);
   ASSERT_GT(edges, 150);
-  const double filtered_rmse = std::sqrt(filtered_sq / edges);
-  const double point_rmse = std::sqrt(point_sq / edges);
   std::printf(
       "[ measure  ] slanted board edges (%d px) against a supersampled render: RMSE %.4f "
       "per-pixel estimate, %.4f with the pixel filter; largest change away from edges %.4f\n",
       edges, point_rmse, filtered_rmse, moved_inside);
   EXPECT_LT(filtered_rmse, 0.8 * point_rmse);
   EXPECT_LT(moved_inside, 0.05);
+}
+
+// The same board, red, before a blue wall, with the beauty a renderer would write: each
+// surface's colour filtered over the pixel like the AO pass. Where the Depth pass holds one
+// surface, the beauty says how much of the pixel each covers (edge_coverage = beauty).
+TEST(Analytic, BeautyCoverageMixesBothSurfacesAtEdgesAsASupersampledRender) {
+  SlantedBoard b;
+  const Scene& s = b.s;
+  const auto colour_at = [&](int i, int j, int c) {
+    V3 o, d, normal{0, 0, 0};
+    b.cam.ray_at((i + 0.5) / b.kSub, (j + 0.5) / b.kSub, o, d);
+    const bool board = -(o + d * first_hit(b.solids, o, d, normal)).z < 5.45;
+    static constexpr double kBoard[3] = {0.8, 0.25, 0.1}, kWall[3] = {0.15, 0.3, 0.7};
+    return board ? kBoard[c] : kWall[c];
+  };
+  std::vector<float> beauty(s.depth.size() * 3, 0.0f);
+  for (int y = 1; y + 1 < s.height; ++y) {
+    for (int x = 1; x + 1 < s.width; ++x) {
+      for (int c = 0; c < 3; ++c) {
+        beauty[b.index(x, y) * 3 + c] =
+            float(b.filtered(x, y, [&](int i, int j) { return colour_at(i, j, c); }));
+      }
+    }
+  }
+  const auto with = [&](const char* coverage, std::vector<float>* image) {
+    return compute_ao(b.s, b.cam, b.radius, "hemisphere", true, [&](Job& j) {
+      j.set("resolution", "full");
+      j.set("edge_coverage", coverage);
+      if (image != nullptr) j.image("beauty", *image, s.width, s.height, 3);
+    });
+  };
+  const auto filtered = with("none", &beauty);
+  const auto mixed = with("beauty", &beauty);
+  int changed_inside = 0;
+  for (size_t i = 0; i < mixed.size(); ++i) changed_inside += !b.edge[i] && mixed[i] != filtered[i];
+  int edges = 0;
+  const double filtered_rmse = b.edge_rmse(filtered, edges);
+  const double mixed_rmse = b.edge_rmse(mixed, edges);
+  ASSERT_GT(edges, 150);
+  std::printf(
+      "[ measure  ] slanted board edges (%d px) against a supersampled render: RMSE %.4f with "
+      "the pixel filter, %.4f with the beauty's coverage\n",
+      edges, filtered_rmse, mixed_rmse);
+  EXPECT_LT(mixed_rmse, 0.8 * filtered_rmse);
+  EXPECT_EQ(changed_inside, 0) << "only pixels on a depth edge change";
+  // Without a beauty, or with one that cannot be read, edge_coverage = beauty changes nothing.
+  EXPECT_EQ(with("beauty", nullptr), filtered);
+  std::vector<float> unreadable(beauty.size(), std::numeric_limits<float>::quiet_NaN());
+  EXPECT_EQ(with("beauty", &unreadable), filtered);
+  // Without the pixel filter the two pixels' own AO are mixed.
+  const auto unfiltered = [&](const char* coverage) {
+    return compute_ao(b.s, b.cam, b.radius, "hemisphere", true, [&](Job& j) {
+      j.set("resolution", "full");
+      j.set("pixel_filter", 0.0);
+      j.set("edge_coverage", coverage);
+      j.image("beauty", beauty, s.width, s.height, 3);
+    });
+  };
+  const auto point = unfiltered("none"), point_mixed = unfiltered("beauty");
+  int point_edges = 0;
+  EXPECT_LT(b.edge_rmse(point_mixed, point_edges), 0.8 * b.edge_rmse(point, point_edges));
+  std::vector<float> flat(beauty.size(), 0.5f);
+  EXPECT_EQ(with("beauty", &flat), filtered) << "one colour says nothing of coverage";
 }
 
 // A renderer's Normal pass is filtered over each pixel like the beauty: on a crease it holds the

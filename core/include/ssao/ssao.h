@@ -156,7 +156,9 @@ SSAO_API ssao_status ssao_job_get_floats(ssao_job job, const char* name, double*
  *   "depth"     input, required, channel 0 read
  *   "normal"    input, optional, channels 0..2 read (space given by "normal_space"); without it,
  *               normals are reconstructed from depth
- *   "beauty"    input, 1..4 channels, needed by "composite"
+ *   "beauty"    input, 1..4 channels, needed by "composite"; with edge_coverage = beauty its
+ *               colours (channels 0..2, or 0 as grey) also say how much of a pixel on a depth
+ *               edge each surface covers (docs/variants.md, "Edge coverage from the beauty")
  *   "ambient"   input, optional, as many channels as "beauty": the part of the beauty that AO
  *               darkens (light that does not come straight from a light source)
  *   "ao"        output: AO written to channels 0..min(channels,3)-1, channel 3 (if any) set to 1
