@@ -289,11 +289,13 @@ void Job::set_image(const char* name, float* data, int width, int height, int ch
   if (name == nullptr) throw_invalid_argument("image name is NULL");
   ImageView* slot = image_slot(name);
   if (slot == nullptr) {
-    throw_invalid_argument(std::string("unknown image '") + name +
-                           "' (expected depth, normal, beauty, ambient, ao, composite, depth2 to "
-                           "depth" +
-                           std::to_string(kMaxExtraLayers + 1) + " or facing2 to facing" +
-                           std::to_string(kMaxExtraLayers + 1) + ")");
+    throw_invalid_argument(
+        std::string("unknown image '") + name +
+        "' (expected depth, normal, beauty, edge_colours, ambient, ao, composite, "
+        "depth2 to "
+        "depth" +
+        std::to_string(kMaxExtraLayers + 1) + " or facing2 to facing" +
+        std::to_string(kMaxExtraLayers + 1) + ")");
   }
   const int min_channels = slot == &normal_ ? 3 : 1, max_channels = 4;
   if (data == nullptr) {
@@ -345,9 +347,13 @@ void Job::set_image(const char* name, float* data, int width, int height, int ch
 }
 
 ImageView* Job::image_slot(const char* name) {
-  const std::pair<const char*, ImageView*> named[] = {
-      {"depth", &depth_},     {"normal", &normal_}, {"beauty", &beauty_},
-      {"ambient", &ambient_}, {"ao", &ao_out_},     {"composite", &composite_out_}};
+  const std::pair<const char*, ImageView*> named[] = {{"depth", &depth_},
+                                                      {"normal", &normal_},
+                                                      {"beauty", &beauty_},
+                                                      {"edge_colours", &edge_colours_},
+                                                      {"ambient", &ambient_},
+                                                      {"ao", &ao_out_},
+                                                      {"composite", &composite_out_}};
   for (const auto& [image, slot] : named) {
     if (std::strcmp(name, image) == 0) return slot;
   }
@@ -389,6 +395,7 @@ void Job::validate_images() const {
     inputs.push_back({"facing" + number, &facing_[k]});
   }
   const std::pair<const char*, const ImageView*> outputs[] = {{"beauty", &beauty_},
+                                                              {"edge_colours", &edge_colours_},
                                                               {"ambient", &ambient_},
                                                               {"ao", &ao_out_},
                                                               {"composite", &composite_out_}};
@@ -542,7 +549,11 @@ void Job::run() {
   const float radius = static_cast<float>(v.get_float("radius"));
   const Denoiser denoiser(seen, denoise_mode(v.get_string("denoise")), radius);
   const float filter_weight = pixel_filter_weight(v.get_float("pixel_filter"));
-  const bool edges_from_beauty = v.get_string("edge_coverage") == "beauty" && beauty_.attached();
+  // The colours that tell each surface's share of an edge pixel: the beauty's, unless the front
+  // end gave others (its beauty is not the picture).
+  const ImageView& edge_colours = edge_colours_.attached() ? edge_colours_ : beauty_;
+  const bool edges_from_beauty =
+      v.get_string("edge_coverage") == "beauty" && edge_colours.attached();
   // A frame of a sequence (frame >= 0) averages the frames before it that this job computed.
   const int frame_number = v.get_int("frame");
   temporal_.begin(frame_number, frame_number >= 0 ? v.get_int("temporal_frames") : 1, camera,
@@ -599,7 +610,7 @@ void Job::run() {
         }
       }
       if (edges_from_beauty) {
-        mix_edges_by_beauty(frame, beauty_, dx, dy, around, resolved.data(), t, filter_weight,
+        mix_edges_by_beauty(frame, edge_colours, dx, dy, around, resolved.data(), t, filter_weight,
                             denoised.data());
       }
     } else {

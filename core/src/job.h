@@ -76,7 +76,7 @@ class Job {
   // How many extra depth layers are attached (depth2, depth3, ... without a gap).
   int extra_layers() const;
 
-  ImageView depth_, normal_, beauty_, ambient_, ao_out_, composite_out_;
+  ImageView depth_, normal_, beauty_, edge_colours_, ambient_, ao_out_, composite_out_;
   ImageView layers_[kMaxExtraLayers], facing_[kMaxExtraLayers];
   CameraFile camera_file_;
   RunStats last_run_;

@@ -148,8 +148,9 @@ const std::vector<Param>& params() {
                    "beauty: at a depth edge, where the \"beauty\" image is attached and the two "
                    "surfaces' colours differ enough, the pixel's AO is the two surfaces' AO "
                    "(each through the pixel filter) mixed by the share of the pixel each covers, "
-                   "read from the anti-aliased beauty, as a renderer's AO pass mixes them (the "
-                   "Depth pass holds one surface); elsewhere, and without a beauty, the pixel "
+                   "read from the anti-aliased beauty (or the \"edge_colours\" image in its "
+                   "place), as a renderer's AO pass mixes them (the Depth pass holds one "
+                   "surface); elsewhere, and without a beauty, the pixel "
                    "filter alone; not for a beauty whose edges are not the depth's (depth of "
                    "field or motion blur rendered into it). none: the pixel filter alone"),
       // --- camera (Blender's bpy.types.Camera names) ---

@@ -461,6 +461,18 @@ TEST(Analytic, BeautyCoverageMixesBothSurfacesAtEdgesAsASupersampledRender) {
   EXPECT_LT(b.edge_rmse(point_mixed, point_edges), 0.8 * b.edge_rmse(point, point_edges));
   std::vector<float> flat(beauty.size(), 0.5f);
   EXPECT_EQ(with("beauty", &flat), filtered) << "one colour says nothing of coverage";
+  // "edge_colours" stands in for the beauty's colours: a front end whose beauty is a white
+  // factor image (Blender's node) gets the same AO.
+  const auto guided = [&](const char* coverage) {
+    return compute_ao(b.s, b.cam, b.radius, "hemisphere", true, [&](Job& j) {
+      j.set("resolution", "full");
+      j.set("edge_coverage", coverage);
+      j.image("beauty", flat, s.width, s.height, 3);
+      j.image("edge_colours", beauty, s.width, s.height, 3);
+    });
+  };
+  EXPECT_EQ(guided("beauty"), mixed);
+  EXPECT_EQ(guided("none"), filtered);
 }
 
 // A renderer's Normal pass is filtered over each pixel like the beauty: on a crease it holds the

@@ -138,6 +138,12 @@ TEST(Api, ImageErrors) {
   EXPECT_EQ(ssao_job_run(job.get()), SSAO_ERROR_INVALID_ARGUMENT);
   EXPECT_TRUE(contains(ssao_last_error(), "'ao' is 2x2 but depth is 4x4"));
   ASSERT_EQ(ssao_job_set_image(job.get(), "ao", nullptr, 0, 0, 1, 0, 0), SSAO_OK);
+  ASSERT_EQ(ssao_job_set_image(job.get(), "ao", ao.data(), 4, 4, 1, 0, 0), SSAO_OK);
+  ASSERT_EQ(ssao_job_set_image(job.get(), "edge_colours", small.data(), 2, 2, 1, 0, 0), SSAO_OK);
+  EXPECT_EQ(ssao_job_run(job.get()), SSAO_ERROR_INVALID_ARGUMENT);
+  EXPECT_TRUE(contains(ssao_last_error(), "'edge_colours' is 2x2 but depth is 4x4"));
+  ASSERT_EQ(ssao_job_set_image(job.get(), "edge_colours", nullptr, 0, 0, 1, 0, 0), SSAO_OK);
+  ASSERT_EQ(ssao_job_set_image(job.get(), "ao", nullptr, 0, 0, 1, 0, 0), SSAO_OK);
   ASSERT_EQ(ssao_job_set_image(job.get(), "composite", rgb.data(), 4, 4, 3, 0, 0), SSAO_OK);
   EXPECT_EQ(ssao_job_run(job.get()), SSAO_ERROR_INVALID_OPERATION);
   EXPECT_TRUE(contains(ssao_last_error(), "needs a 'beauty'"));

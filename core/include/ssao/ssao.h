@@ -159,6 +159,10 @@ SSAO_API ssao_status ssao_job_get_floats(ssao_job job, const char* name, double*
  *   "beauty"    input, 1..4 channels, needed by "composite"; with edge_coverage = beauty its
  *               colours (channels 0..2, or 0 as grey) also say how much of a pixel on a depth
  *               edge each surface covers (docs/variants.md, "Edge coverage from the beauty")
+ *   "edge_colours"
+ *               input, optional, 1..4 channels, the beauty's size: the colours edge_coverage =
+ *               beauty reads in place of the beauty's (a front end whose "beauty" is not the
+ *               picture, e.g. a white image whose composite is a factor)
  *   "ambient"   input, optional, as many channels as "beauty": the part of the beauty that AO
  *               darkens (light that does not come straight from a light source)
  *   "ao"        output: AO written to channels 0..min(channels,3)-1, channel 3 (if any) set to 1
@@ -195,12 +199,12 @@ SSAO_API ssao_status ssao_job_set_image(ssao_job job, const char* name, float* d
                                         ptrdiff_t row_stride);
 /* Overscan: the depth, normal and extra layer images extend beyond the frame (a guard band rendered
  * with the same camera on the same pixel grid), and the frame is the window of the outputs' size
- * whose top-left pixel is pixel (x, y) of the depth image. "beauty", "ambient", "ao" and
- * "composite" then have the window's size (all the same), the window must lie inside the depth
- * image, and the camera parameters describe the window (the frame as rendered without the band).
- * The AO of the window is computed from every pixel of the depth image: it equals a run on the
- * whole depth image with the camera widened to it, cropped. Call with enable = 0 to go back to the
- * default: every image of the depth image's size. */
+ * whose top-left pixel is pixel (x, y) of the depth image. "beauty", "edge_colours", "ambient",
+ * "ao" and "composite" then have the window's size (all the same), the window must lie inside the
+ * depth image, and the camera parameters describe the window (the frame as rendered without the
+ * band). The AO of the window is computed from every pixel of the depth image: it equals a run on
+ * the whole depth image with the camera widened to it, cropped. Call with enable = 0 to go back to
+ * the default: every image of the depth image's size. */
 SSAO_API ssao_status ssao_job_set_output_window(ssao_job job, int enable, int x, int y);
 /* Sets (or, with fn == NULL, clears) the progress callback. */
 SSAO_API ssao_status ssao_job_set_progress(ssao_job job, ssao_progress_fn fn, void* user);

@@ -135,8 +135,8 @@ def _check_image(name, array, shape, channels=None):
 
 
 def ambient_occlusion(depth, *, normals=None, camera, depth_layers=(), facing_layers=(),
-                      beauty=None, ambient=None, output_window=None, progress=None,
-                      require_geometry=True, run_stats=None, **parameters):
+                      beauty=None, ambient=None, edge_colours=None, output_window=None,
+                      progress=None, require_geometry=True, run_stats=None, **parameters):
     """The AO of a depth pass: float32 (height, width), 1 = unoccluded, row 0 on top.
 
     depth          float32 (H, W): planar depth (Blender's Depth pass) or radial
@@ -152,6 +152,9 @@ def ambient_occlusion(depth, *, normals=None, camera, depth_layers=(), facing_la
     beauty         float32 (h, w) or (h, w, 1..4), optional: then (ao, composite) is returned,
                    composite = beauty darkened by the AO; `ambient` (same shape) is the part
                    of the beauty AO darkens.
+    edge_colours   float32, optional, the beauty's height and width, 1..4 channels: the
+                   colours edge_coverage="beauty" reads in place of the beauty's (a beauty
+                   that is not the picture, e.g. a white image whose composite is a factor).
     output_window  (x, y, width, height), optional: overscan. The inputs extend beyond the
                    frame, which is this window of them; the outputs have the window's size and
                    the camera describes the frame.
@@ -170,13 +173,13 @@ def ambient_occlusion(depth, *, normals=None, camera, depth_layers=(), facing_la
     return _ambient_occlusion(
         None, depth, normals=normals, camera=camera, depth_layers=depth_layers,
         facing_layers=facing_layers, beauty=beauty, ambient=ambient,
-        output_window=output_window, progress=progress, require_geometry=require_geometry,
-        run_stats=run_stats, **parameters)
+        edge_colours=edge_colours, output_window=output_window, progress=progress,
+        require_geometry=require_geometry, run_stats=run_stats, **parameters)
 
 
 def _ambient_occlusion(job, depth, *, normals=None, camera, depth_layers=(), facing_layers=(),
-                       beauty=None, ambient=None, output_window=None, progress=None,
-                       require_geometry=True, run_stats=None, **parameters):
+                       beauty=None, ambient=None, edge_colours=None, output_window=None,
+                       progress=None, require_geometry=True, run_stats=None, **parameters):
     """ambient_occlusion() in `job` (a Sequence's: its images are detached after the run), or
     in a job of its own (None)."""
     import numpy as np
@@ -200,6 +203,8 @@ def _ambient_occlusion(job, depth, *, normals=None, camera, depth_layers=(), fac
         _check_image("ambient", ambient, frame)
         if ambient.shape != beauty.shape:
             raise SSAOError(f"ambient has shape {ambient.shape}, beauty {beauty.shape}")
+    if edge_colours is not None:
+        _check_image("edge_colours", edge_colours, frame, channels=(1, 2, 3, 4))
 
     if isinstance(camera, (str, os.PathLike)):
         camera = read_camera(camera)
@@ -223,6 +228,8 @@ def _ambient_occlusion(job, depth, *, normals=None, camera, depth_layers=(), fac
         else:  # cleared: a Sequence's job keeps the window of the frame before
             job.set_output_window(0, 0, enable=False)
         job.set_image("ao", ao)
+        if edge_colours is not None:
+            job.set_image("edge_colours", edge_colours)
         if beauty is not None:
             job.set_image("beauty", beauty)
             if ambient is not None:
