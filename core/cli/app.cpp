@@ -35,9 +35,11 @@ struct Inputs {
   ssao_tools::FloatBuffer depth;   // 1 channel
   ssao_tools::FloatBuffer normal;  // 3 channels or empty
   ssao_tools::FloatBuffer beauty;  // 3 or 4 channels or empty
+  bool composite = true;           // false with --ao-only: the beauty only guides edge coverage
   // The 2nd, 3rd, ... hit's depth, 1 channel each, and its facing (empty when not given).
   std::vector<ssao_tools::FloatBuffer> layer_depth, layer_facing;
   int beauty_channels() const { return static_cast<int>(passes.beauty.size()); }
+  int composite_channels() const { return composite ? beauty_channels() : 0; }
 };
 
 // What the core writes, straight into the layout of the output file: R, G, B[, A] (the
@@ -86,7 +88,8 @@ ssao_tools::PassChannels choose_passes(const Options& options, const ssao_tools:
                                        const ssao_tools::PassOverrides& overrides) {
   ssao_tools::PassChannels passes =
       ssao_tools::detect_passes(header.channel_names, overrides, options.input);
-  if (options.ao_only) passes.beauty.clear();
+  // With --ao-only a beauty found is still read: edge_coverage = beauty takes each surface's
+  // share of an edge pixel from its colours, so the AO is the same as with a composite.
   if (!options.ao_only && passes.beauty.empty()) {
     throw ssao_tools::Error(
         "'" + options.input + "' has no beauty pass (looked for " +
@@ -111,6 +114,7 @@ Inputs load_inputs(const Options& options, Inputs recycled = Inputs()) {
   overrides.no_depth_layers = options.no_depth_layers;
   const auto choose = [&](const ssao_tools::Image& header) {
     in.image = header;
+    in.composite = !options.ao_only;
     in.passes = choose_passes(options, header, overrides);
     std::vector<ssao_tools::ChannelTarget> targets;
     const auto pass = [&](const std::vector<std::string>& names, ssao_tools::FloatBuffer& buffer) {
@@ -160,7 +164,7 @@ void attach_images(ssao::api::Job& job, Inputs& in, Outputs& out) {
   // read in place, the frame's window of the data.
   const int w = image.frame_width, h = image.frame_height;
   job.set_output_window(image.has_overscan(), image.frame_x, image.frame_y);
-  const int colour = in.beauty_channels();  // 0 with --ao-only
+  const int colour = in.composite_channels();  // 0 with --ao-only
   const size_t stride = size_t(colour) + 1;
   out.names = {"R", "G", "B", "A"};
   out.names.resize(size_t(colour));
@@ -170,12 +174,21 @@ void attach_images(ssao::api::Job& job, Inputs& in, Outputs& out) {
   out.pixels.resize(count);  // the core writes every value
   const std::ptrdiff_t pixel_bytes = std::ptrdiff_t(stride * sizeof(float));
   job.set_image("ao", out.pixels.data() + colour, w, h, 1, pixel_bytes, pixel_bytes * w);
+  const int beauty_channels = in.beauty_channels();
+  const auto attach_beauty = [&](const char* name, bool attach) {
+    if (!attach) {
+      job.set_image(name, nullptr, 0, 0, 1);
+      return;
+    }
+    const ssao_tools::FrameView beauty =
+        ssao_tools::frame_view(image, in.beauty.data(), beauty_channels);
+    job.set_image(name, beauty.data, w, h, beauty_channels, beauty.pixel_stride, beauty.row_stride);
+  };
+  attach_beauty("beauty", colour > 0);
+  attach_beauty("edge_colours", colour == 0 && beauty_channels > 0);
   if (colour > 0) {
-    const ssao_tools::FrameView beauty = ssao_tools::frame_view(image, in.beauty.data(), colour);
-    job.set_image("beauty", beauty.data, w, h, colour, beauty.pixel_stride, beauty.row_stride);
     job.set_image("composite", out.pixels.data(), w, h, colour, pixel_bytes, pixel_bytes * w);
   } else {
-    job.set_image("beauty", nullptr, 0, 0, 1);
     job.set_image("composite", nullptr, 0, 0, 1);
   }
 }

@@ -104,6 +104,26 @@ class AgainstCli(unittest.TestCase):
         for c, name in enumerate("RGBA"):
             self.assert_same_bits(np.ascontiguousarray(composite[:, :, c]), cli[name])
 
+    def test_edge_colours_and_ao_only_give_the_composites_ao(self):
+        # With edge_coverage = beauty the AO at depth edges reads the beauty's colours: the
+        # CLI reads them with --ao-only too, and edge_colours stands in for a white beauty.
+        ao, _ = ssao.ambient_occlusion(self.depth, normals=self.normals, camera=self.camera,
+                                       radius=0.8, beauty=self.beauty, edge_coverage="beauty")
+        plain = ssao.ambient_occlusion(self.depth, normals=self.normals, camera=self.camera,
+                                       radius=0.8, edge_coverage="none")
+        self.assertGreater(np.count_nonzero(ao != plain), 20)  # the sample has such edges
+        white = np.ones_like(self.beauty)
+        guided, _ = ssao.ambient_occlusion(
+            self.depth, normals=self.normals, camera=self.camera, radius=0.8, beauty=white,
+            edge_colours=self.beauty, edge_coverage="beauty")
+        self.assert_same_bits(guided, ao)
+        for flags in (("--ao-only",), ()):
+            self.assert_same_bits(ao, run_cli("--radius", "0.8", "--edge-coverage", "beauty",
+                                              *flags)["AO"])
+        with self.assertRaises(ssao.SSAOError):
+            ssao.ambient_occlusion(self.depth, camera=self.camera, beauty=self.beauty,
+                                   edge_colours=self.beauty[:-1])
+
     def test_docs_example(self):
         # docs/examples/ambient_occlusion.py, as docs/python.md runs it.
         example = os.path.join(HERE, "..", "..", "docs", "examples", "ambient_occlusion.py")
