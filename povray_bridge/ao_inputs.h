@@ -21,6 +21,7 @@ struct AoInputs {
   int band = 0;
   std::vector<float> beauty;  // R, G, B, A (linear; A = 1 when the beauty has none)
   bool beauty_has_alpha = false;
+  bool beauty_blurred = false;     // focal blur rendered into it: its edges are not the depth's
   std::vector<float> radial;       // the frame's distance from the camera; +inf on background
   std::vector<float> planar;       // the frame's depth along the view axis; +inf on background
   bool planar_input = false;       // give libssao the planar depth (orthographic, planar files)

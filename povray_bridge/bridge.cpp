@@ -73,7 +73,8 @@ void report_camera(const Options& o, const ImageScene& scene, int width, int hei
   if (scene_camera_for_frame(o, reading)) {
     report.progress(
         "focal blur: the beauty and the ambient pass keep the scene's camera and its blur; AO "
-        "comes from sharp depth%s passes, so it is sharp where the image is blurred",
+        "comes from sharp depth%s passes, so it is sharp where the image is blurred (and its "
+        "edges are not read from the beauty: edge_coverage none)",
         scene.scan.includes_ssao_passes && !o.no_normals ? " and normal" : "");
   } else if (reading.had_focal_blur) {
     report.warning(
@@ -130,6 +131,7 @@ void render_image(const Options& o, const RenderSetup& setup, const AnimationFra
   in.height = height;
   in.band = band;
   in.camera = reading.camera;
+  in.beauty_blurred = scene_camera_for_frame(o, reading);
   passes.finish_depth(in);
   if (o.depth_only) {
     write_depth_only(o.output, in);

@@ -35,6 +35,9 @@ void set_up_job(ssao::api::Job& job, const std::vector<ssao_tools::ParamSetting>
   in.camera.apply_to_job(job, in.width, in.height);
   job.set("depth_kind", in.planar_input ? "planar" : "radial");
   if (!in.normals.empty()) job.set("normal_space", "camera");
+  // A blurred beauty cannot say where a sharp depth edge lies (an --edge-coverage flag still
+  // wins).
+  if (in.beauty_blurred) job.set("edge_coverage", "none");
   ssao_tools::apply_params(job, params);
 
   images.ao.assign(in.frame_pixels(), 1.0f);

@@ -1494,8 +1494,12 @@ class FocalBlurTest(PovTestCase):
         scene, proc, names, pixels, kept = self.run_scene(FOCAL_BLUR_SCENE, "blurred")
         self.assertIn("focal blur: the beauty and the ambient pass keep", proc.stdout,
                       self.detail(proc))
+        self.assertIn("edge_coverage none", proc.stdout, self.detail(proc))
         sharp_text = FOCAL_BLUR_SCENE.replace("aperture 0.6", "aperture 0")
-        _, _, sharp_names, sharp_pixels, sharp_kept = self.run_scene(sharp_text, "sharp")
+        # The blurred beauty's edges are not the depth's: the bridge reads none of them
+        # (edge_coverage none), so the AO is the sharp scene's without them.
+        _, _, sharp_names, sharp_pixels, sharp_kept = self.run_scene(
+            sharp_text, "sharp", "--edge-coverage", "none")
         # The beauty is POV-Ray's own render of the scene, focal blur included (measured:
         # identical), and visibly not the sharp one.
         size = (f"+W{self.SIZE[0]}", f"+H{self.SIZE[1]}")
@@ -1511,6 +1515,12 @@ class FocalBlurTest(PovTestCase):
                                           channel(sharp_names, sharp_pixels, c), err_msg=c)
         ao = channel(names, pixels, "AO")
         self.assertLess(float(ao[np.isfinite(channel(names, pixels, "Z"))].mean()), 0.99)
+        # Without focal blur the sharp beauty places the edges (edge_coverage beauty, the
+        # library's default), which changes the AO there: what the blurred run would get wrong.
+        _, _, edge_names, edge_pixels, _ = self.run_scene(sharp_text, "sharp_edges",
+                                                          "--edge-coverage", "beauty")
+        edges = np.abs(channel(edge_names, edge_pixels, "AO") - channel(names, pixels, "AO"))
+        self.assertGreater(int(np.count_nonzero(edges > 1e-3)), 5)
 
     def test_multiplied_beauty_and_camera_flags(self):
         _, proc, names, pixels, kept = self.run_scene(FOCAL_BLUR_SCENE, "beauty", "--apply-to",
