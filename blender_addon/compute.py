@@ -30,9 +30,10 @@ EEVEE_BACKGROUND_DEPTH = 65504.0
 # The library's parameter groups (ssao_param_group) the node shows: every parameter that
 # changes the look. The input, camera and execution groups the add-on sets itself.
 NODE_GROUPS = ("ao", "quality", "shaping")
-# And, of the execution group, the temporal filter's length: how many frames of an animation
-# render the AO averages (Sequences below; 1: each frame alone).
-NODE_EXECUTION_PARAMETERS = ("temporal_frames",)
+# Beyond those groups: of the execution group, the temporal filter's length, how many frames
+# of an animation render the AO averages (Sequences below; 1: each frame alone); of the input
+# group, whether the Image's colours place the edges (off for an Image blurred before the node).
+NODE_EXTRA_PARAMETERS = ("temporal_frames", "edge_coverage")
 
 
 @functools.lru_cache(maxsize=1)
@@ -41,7 +42,7 @@ def library_table():
     the library cannot be loaded; a later call tries again):
       parameters: {name: description (ssao.parameters)}, in the library's order;
       node_parameter_names: the names the node shows (NODE_GROUPS and
-        NODE_EXECUTION_PARAMETERS), in the library's order;
+        NODE_EXTRA_PARAMETERS), in the library's order;
       variant_parameters: {variant: the names only that variant reads}."""
     lib = library()
     parameters = {p["name"]: p for p in ssao.parameters(lib)}
@@ -49,7 +50,7 @@ def library_table():
         parameters=parameters,
         node_parameter_names=tuple(name for name, p in parameters.items()
                                    if p["group"] in NODE_GROUPS or
-                                   name in NODE_EXECUTION_PARAMETERS),
+                                   name in NODE_EXTRA_PARAMETERS),
         variant_parameters={v["name"]: set(v["parameters"]) for v in ssao.variants(lib)})
 
 
@@ -149,14 +150,15 @@ def configure_node(node, folder=None):
 
 def read_export(path):
     """The exported passes as a bottom-up float32 array (height, width, 4): normal xyz, depth;
-    (height, width, 5) with the Image's alpha when it was exported with them (the composite's
-    coverage on a transparent film; inner_tree.py)."""
+    (height, width, 8) with the Image's RGBA when it was exported with them (its alpha is the
+    composite's coverage on a transparent film, its colours the library's edge_colours;
+    inner_tree.py)."""
     passes = _read_rgba(path)
-    alpha_path = inner_tree.alpha_export_path(path)
-    alpha = _read_rgba(alpha_path) if alpha_path is not None else None
-    if alpha is None or alpha.shape != passes.shape:
+    image_path = inner_tree.image_export_path(path)
+    image = _read_rgba(image_path) if image_path is not None else None
+    if image is None or image.shape != passes.shape:
         return passes
-    return np.concatenate([passes, alpha[:, :, :1]], axis=2)
+    return np.concatenate([passes, image], axis=2)
 
 
 def _read_rgba(path):
@@ -395,7 +397,7 @@ class Sequences:
 
 def compute_node(node, scene, passes, wait=True, run_stats=None, sequences=None):
     """AO of `node` from exported `passes` (read_export's: normal xyz, depth[, the Image's
-    alpha]); fills the node's AO image (with the composite's factor: inner_tree.py) and returns
+    RGBA]); fills the node's AO image (with the composite's factor: inner_tree.py) and returns
     the AO with row 0 on top. Raises, leaving the AO image as it was, when the inputs, the
     parameters or the library cannot give this frame's AO. With wait=False (the UI) a helper
     render the node needs is asked of helper_process and, until its layers come, the AO is
@@ -424,6 +426,7 @@ def compute_node(node, scene, passes, wait=True, run_stats=None, sequences=None)
         images["depth"], normals=images.get("normal"), camera=None,
         depth_layers=[images[f"depth{k}"] for k in layers],
         facing_layers=[images[f"facing{k}"] for k in layers], beauty=beauty,
+        edge_colours=inner_tree.image_colours(passes),
         output_window=(overscan, overscan, width, height) if overscan else None,
         require_geometry=False, run_stats=run_stats,
         **camera, background_depth=background,  # the same as the Normal check's

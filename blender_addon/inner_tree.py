@@ -6,8 +6,9 @@ composites (with the last computed AO) where the add-on is not installed:
     Normal -> Separate Color -> R, G, B ┐
     Depth  ------------------------> A  ┴ Combine Color -> File Output "SSAO Export"
                                           (a lossless 32-bit EXR, read back by compute.py)
-    Image  -> Separate Color "SSAO Image Alpha" -> Alpha -> File Output "SSAO Export Alpha"
-                                          (the same file name in the folder alpha/ beside it)
+    Image  ------------------------------------------> File Output "SSAO Export Alpha"
+                                          (RGBA, the same file name in the folder image/ beside
+                                          it: the composite's coverage and edge_colours)
   Image node "SSAO AO" (filled by compute.py) -> Separate Color "SSAO Channels"
     Red:   the AO                                           -> Output AO
     Green: the composite's factor -> Multiply with Image    -> Output Image
@@ -28,13 +29,14 @@ from . import compat
 
 NODE_IDNAME = "CompositorNodeSSAO"
 EXPORT_NODE, AO_NODE, MULTIPLY_NODE = "SSAO Export", "SSAO AO", "SSAO Multiply"
-# Added for the library's composite (issue 33); trees saved before get them in upgrade().
-CHANNELS_NODE, ALPHA_NODE, ALPHA_EXPORT_NODE = \
+# Added for the library's composite (issue 33); trees saved before get them in upgrade(). The
+# Image's export was named when it wrote the alpha alone (from ALPHA_NODE's Alpha output).
+CHANNELS_NODE, ALPHA_NODE, IMAGE_EXPORT_NODE = \
     "SSAO Channels", "SSAO Image Alpha", "SSAO Export Alpha"
-ALPHA_FOLDER = "alpha"  # the alpha export's folder, inside the passes export's
-# The two exports are written by one compositor run: an alpha file older than its passes file
+IMAGE_FOLDER = "image"  # the Image export's folder, inside the passes export's
+# The two exports are written by one compositor run: an Image file older than its passes file
 # by more than this is from another render (and is not used).
-ALPHA_EXPORT_SLACK_SECONDS = 60.0
+IMAGE_EXPORT_SLACK_SECONDS = 60.0
 
 
 def build(ssao_id):
@@ -76,7 +78,7 @@ def build(ssao_id):
     links.new(group_in.outputs["Image"], image_in)
     links.new(result, group_out.inputs["Image"])
     _add_channels(tree, ao_in)
-    _add_alpha_export(tree)
+    _add_image_export(tree)
     return tree
 
 
@@ -101,20 +103,27 @@ def _add_channels(tree, factor_in):
     tree.links.new(channels.outputs["Red"], group_out.inputs["AO"])
 
 
-def _add_alpha_export(tree):
-    """The Image's alpha, written beside the passes (read back by compute.py: the composite's
-    coverage on a transparent film)."""
-    group_in, _ = _group_nodes(tree)
-    alpha = tree.nodes.new("CompositorNodeSeparateColor")
-    alpha.mode = 'RGB'
-    alpha.name = alpha.label = ALPHA_NODE
-    alpha.location = (-150, -450)
+def _add_image_export(tree):
+    """The Image (colour and alpha), written beside the passes (read back by compute.py: its
+    alpha is the composite's coverage on a transparent film, its colours the library's
+    edge_colours)."""
     # Its one input has the exporter's name: 5.x names files file name + input name.
     exporter = compat.new_file_output(tree, ["Passes"])
-    exporter.name = exporter.label = ALPHA_EXPORT_NODE
+    exporter.name = exporter.label = IMAGE_EXPORT_NODE
     exporter.location = (100, -450)
-    tree.links.new(group_in.outputs["Image"], alpha.inputs[0])
-    tree.links.new(alpha.outputs["Alpha"], exporter.inputs[0])
+    _link_image_export(tree)
+
+
+def _link_image_export(tree):
+    """The Image straight into its exporter; a tree saved when the exporter wrote the Image's
+    alpha alone (through ALPHA_NODE) loses that node."""
+    group_in, _ = _group_nodes(tree)
+    exporter = tree.nodes[IMAGE_EXPORT_NODE]
+    if ALPHA_NODE in tree.nodes:
+        tree.nodes.remove(tree.nodes[ALPHA_NODE])
+    for link in list(exporter.inputs[0].links):
+        tree.links.remove(link)
+    tree.links.new(group_in.outputs["Image"], exporter.inputs[0])
 
 
 def upgrade(node):
@@ -131,8 +140,10 @@ def upgrade(node):
         if not multiplied:
             return  # edited by hand: left alone
         _add_channels(tree, multiplied[0])
-    if ALPHA_EXPORT_NODE not in tree.nodes:
-        _add_alpha_export(tree)
+    if IMAGE_EXPORT_NODE not in tree.nodes:
+        _add_image_export(tree)
+    elif ALPHA_NODE in tree.nodes:
+        _link_image_export(tree)
 
 
 def new_id():
@@ -158,13 +169,13 @@ def export_path(node, frame, extra_folders=(), since=0.0):
     return max(existing, key=os.path.getmtime) if existing else None
 
 
-def alpha_export_path(passes_path):
-    """The Image's alpha exported with the passes at `passes_path` (the same file name in the
-    folder alpha/ beside it), or None when no alpha was written with them."""
-    path = os.path.join(os.path.dirname(passes_path), ALPHA_FOLDER,
+def image_export_path(passes_path):
+    """The Image exported with the passes at `passes_path` (the same file name in the folder
+    image/ beside it), or None when it was not written with them."""
+    path = os.path.join(os.path.dirname(passes_path), IMAGE_FOLDER,
                         os.path.basename(passes_path))
     if not os.path.isfile(path) or os.path.getmtime(path) < \
-            os.path.getmtime(passes_path) - ALPHA_EXPORT_SLACK_SECONDS:
+            os.path.getmtime(passes_path) - IMAGE_EXPORT_SLACK_SECONDS:
         return None
     return path
 
@@ -172,18 +183,18 @@ def alpha_export_path(passes_path):
 def point_exporter(node, folder):
     """Points the node's exporters at `folder` (no folder is made: File Output makes it when it
     first writes)."""
-    exporter, alpha = inner(node, EXPORT_NODE), inner(node, ALPHA_EXPORT_NODE)
+    exporter, image = inner(node, EXPORT_NODE), inner(node, IMAGE_EXPORT_NODE)
     if exporter is not None:
         compat.set_file_output_target(exporter, folder, f"ssao_{node.ssao_id}_")
-    if alpha is not None:
-        compat.set_file_output_target(alpha, os.path.join(folder, ALPHA_FOLDER),
+    if image is not None:
+        compat.set_file_output_target(image, os.path.join(folder, IMAGE_FOLDER),
                                       f"ssao_{node.ssao_id}_")
 
 
 def configure(node, folder, size=None):
     """The tree upgraded (upgrade()); the exporter writes lossless 32-bit RGBA EXR into
-    `folder`, the alpha exporter 32-bit RGB (alpha in each channel) into its alpha/ folder; the
-    AO image exists (and has `size`, when given)."""
+    `folder`, the Image exporter 32-bit RGBA into its image/ folder; the AO image exists (and
+    has `size`, when given)."""
     exporter = inner(node, EXPORT_NODE)
     if exporter is None:
         return
@@ -191,17 +202,17 @@ def configure(node, folder, size=None):
     point_exporter(node, folder)
     compat.set_image_format(exporter.format, 'OPEN_EXR', color_depth='32', codec='ZIP',
                             color_mode='RGBA')
-    alpha = inner(node, ALPHA_EXPORT_NODE)
-    if alpha is not None:
-        compat.set_image_format(alpha.format, 'OPEN_EXR', color_depth='32', codec='ZIP',
-                                color_mode='RGB')
+    image = inner(node, IMAGE_EXPORT_NODE)
+    if image is not None:
+        compat.set_image_format(image.format, 'OPEN_EXR', color_depth='32', codec='ZIP',
+                                color_mode='RGBA')
     set_exporter_muted(node, False)
     if size is not None:
         ao_image(node, *size)
 
 
 def set_exporter_muted(node, muted):
-    for name in (EXPORT_NODE, ALPHA_EXPORT_NODE):
+    for name in (EXPORT_NODE, IMAGE_EXPORT_NODE):
         exporter = inner(node, name)
         if exporter is not None:
             exporter.mute = muted
@@ -240,13 +251,20 @@ def ao_image(node, width, height):
 
 def white_beauty(passes):
     """The beauty of a run on `passes` (compute.py's bottom-up export: normal xyz, depth and,
-    when it was exported, the Image's alpha): white with the Image's alpha, row 0 on top. Its
+    when it was exported, the Image's RGBA): white with the Image's alpha, row 0 on top. Its
     composite is the factor the composite applies to the Image (store_outputs)."""
     height, width = passes.shape[:2]
     white = np.ones((height, width, 4), np.float32)
     if passes.shape[2] > 4:
-        white[:, :, 3] = passes[::-1, :, 4]
+        white[:, :, 3] = passes[::-1, :, 7]
     return white
+
+
+def image_colours(passes):
+    """The Image's colours of `passes` (as white_beauty()'s), a view with row 0 on top: the
+    library's "edge_colours" (the white beauty says nothing of where an edge lies). None when
+    the Image was not exported."""
+    return passes[::-1, :, 4:7] if passes.shape[2] > 4 else None
 
 
 def store_outputs(node, ao, composite):

@@ -12,7 +12,8 @@ FACE_PARAMETERS = ("radius", "strength", "quality")
 # The sidebar's box titles: the library's groups, in compute.NODE_GROUPS's order, then the
 # add-on's settings.
 GROUP_TITLES = {"ao": "Occlusion", "quality": "Quality and cost", "shaping": "Shaping",
-                "execution": "Animation"}  # of execution, only temporal_frames
+                "execution": "Animation",  # of execution, only temporal_frames
+                "input": "Edges"}  # of input, only edge_coverage
 SETTINGS_TITLE = "Helper render"
 # Chosen from the costs and gains measured in docs/blender.md, "Hidden surfaces and overscan".
 DEFAULT_HIDDEN_SURFACES = 'PEELED'
@@ -42,6 +43,11 @@ NODE_DESCRIPTIONS = {
                        "near something that moved, or whose AO changed much take no part. "
                        "Steadies the pattern's crawl on camera moves. 1: each frame alone (a "
                        "still always is)",
+    "edge_coverage": "Beauty: where one surface passes in front of another, the AO mixes the "
+                     "two surfaces' AO by the share of the pixel each covers, read from the "
+                     "Image's colours (the last render's), as Cycles' AO pass does; none for an "
+                     "Image whose edges are not the Depth's (blurred before the node: Defocus, "
+                     "or depth of field and motion blur rendered into it)",
 }
 
 

@@ -240,25 +240,39 @@ class AddonTest(unittest.TestCase):
                     os.path.join(folder, "passes", f"{frame:04d}.exr"))[0]
                 for frame in range(1, frames + 1)]
 
-    # The command-line tool's reading of the node's exports (Normal in RGB, Depth in A) with
-    # the test scene's radius, writing the AO alone.
-    CLI_ON_EXPORTS = ("--radius", "0.8", "--depth-channel", "A", "--normal-channels", "R,G,B",
-                      "--ao-only", "--quiet")
+    # The command-line tool's reading of the node's exports (cli_input) with the test scene's
+    # radius, writing the AO alone.
+    CLI_ON_EXPORTS = ("--radius", "0.8", "--ao-only", "--quiet")
 
-    def cli_ao(self, folder, camera_json, frame=1):
+    def cli_input(self, folder, frame):
+        """The node's exports of `frame` (Normal in RGB, Depth in A; the Image, in the image/
+        folder beside them) as one EXR with Blender's channel names, whose beauty the tool
+        reads for the edges (edge_coverage) as the node reads the Image: its path."""
         export = glob.glob(os.path.join(folder, "export", f"ssao_*{frame:04d}.exr"))
         self.assertEqual(len(export), 1, export)
+        passes = read_exr(export[0])
+        image = read_exr(os.path.join(os.path.dirname(export[0]), "image",
+                                      os.path.basename(export[0])))
+        planes = {"ViewLayer.Depth.Z": passes["A"]}
+        planes.update({f"ViewLayer.Normal.{a}": passes[c] for a, c in zip("XYZ", "RGB")})
+        planes.update({f"ViewLayer.Combined.{c}": image[c] for c in "RGBA"})
+        path = os.path.join(folder, "cli_in", f"{frame:04d}.exr")
+        os.makedirs(os.path.dirname(path), exist_ok=True)
+        write_multipart_exr(path, planes)
+        return path
+
+    def cli_ao(self, folder, camera_json, frame=1):
         out = os.path.join(folder, "cli_ao.exr")
-        subprocess.run([CONFIG["cli"], export[0], "--camera", camera_json, "-o", out,
-                        *self.CLI_ON_EXPORTS], check=True)
+        subprocess.run([CONFIG["cli"], self.cli_input(folder, frame), "--camera", camera_json,
+                        "-o", out, *self.CLI_ON_EXPORTS], check=True)
         return read_exr(out)["AO"]
 
     def cli_sequence_ao(self, folder, frames):
         """The command-line tool's AO of the node's exports of frames 1..`frames` as one
         sequence (--frames: its temporal filter), each with its frame's camera file."""
-        export = glob.glob(os.path.join(folder, "export", "ssao_*0001.exr"))
-        self.assertEqual(len(export), 1, export)
-        subprocess.run([CONFIG["cli"], export[0][:-len("0001.exr")] + "####.exr",
+        for frame in range(1, frames + 1):
+            self.cli_input(folder, frame)
+        subprocess.run([CONFIG["cli"], os.path.join(folder, "cli_in", "####.exr"),
                         "--frames", f"1-{frames}",
                         "--camera", os.path.join(folder, "scene.camera.####.json"),
                         "-o", os.path.join(folder, "cli_ao.####.exr"), *self.CLI_ON_EXPORTS],
