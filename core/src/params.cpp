@@ -144,7 +144,7 @@ const std::vector<Param>& params() {
                    "space of the normal image; world needs camera_to_world"),
       float_param(kInput, "background_depth", 1e9, 0.0, kInf, "scene units",
                   "depths at or beyond this are background (Blender writes 1e10)"),
-      string_param(kInput, "edge_coverage", "none", "none|beauty",
+      string_param(kInput, "edge_coverage", "beauty", "none|beauty",
                    "beauty: at a depth edge, where the \"beauty\" image is attached and the two "
                    "surfaces' colours differ enough, the pixel's AO is the two surfaces' AO "
                    "(each through the pixel filter) mixed by the share of the pixel each covers, "

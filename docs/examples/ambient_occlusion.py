@@ -4,8 +4,10 @@
 
     /usr/bin/python3 ambient_occlusion.py RENDER.exr CAMERA.json OUT.exr [RADIUS]
 
-RENDER.exr holds Blender's ViewLayer.Depth.Z and ViewLayer.Normal.X/Y/Z passes; CAMERA.json
-is its camera file (scripts/blender/export_cameras.py). OUT.exr gets one channel, AO.
+RENDER.exr holds Blender's ViewLayer.Depth.Z and ViewLayer.Normal.X/Y/Z passes, and may hold
+the beauty (ViewLayer.Combined.R/G/B: it says how much of an edge pixel each surface covers, as
+the command-line tool reads it); CAMERA.json is its camera file
+(scripts/blender/export_cameras.py). OUT.exr gets one channel, AO.
 """
 import json
 import sys
@@ -31,10 +33,16 @@ def main(render, camera_file, out, radius=None):
     channels = read_exr(render)
     depth = channels["ViewLayer.Depth.Z"]
     normals = np.stack([channels["ViewLayer.Normal." + axis] for axis in "XYZ"], axis=-1)
+    colours = [channels.get("ViewLayer.Combined." + c) for c in "RGB"]
+    if all(c is not None for c in colours):  # the library's default edge_coverage reads them
+        parameters = {"edge_colours": np.stack(colours, axis=-1)}
+    else:
+        parameters = {}
     with open(camera_file) as f:
         camera = json.load(f)
     # Without a radius: the camera file's ao_distance, else the library's automatic one.
-    parameters = {"radius": float(radius)} if radius is not None else {}
+    if radius is not None:
+        parameters["radius"] = float(radius)
     try:
         ao = ssao.ambient_occlusion(depth, normals=normals, camera=camera, **parameters)
     except ssao.SSAOError as error:

@@ -77,23 +77,25 @@ class AgainstCli(unittest.TestCase):
 
     def test_radius_and_normal_pass(self):
         ao = ssao.ambient_occlusion(self.depth, normals=self.normals, camera=self.camera,
-                                    radius=0.8)
+                                    radius=0.8, edge_colours=self.beauty)
         self.assertEqual((ao.dtype, ao.shape), (np.float32, self.depth.shape))
         self.assertGreater(np.count_nonzero(ao < 0.9), 100)  # there is AO to compare
         self.assert_same_bits(ao, run_cli("--radius", "0.8", "--ao-only")["AO"])
 
     def test_automatic_radius_variant_and_no_normals(self):
         ao = ssao.ambient_occlusion(self.depth, camera=self.camera, variant="horizon",
-                                    samples=12)
+                                    samples=12, edge_colours=self.beauty)
         cli = run_cli("--no-normals", "--variant", "horizon", "--samples", "12", "--ao-only")
         self.assert_same_bits(ao, cli["AO"])
 
     def test_ao_distance_is_the_default_radius(self):
         camera = dict(self.camera, ao_distance=0.5)
-        ao = ssao.ambient_occlusion(self.depth, normals=self.normals, camera=camera)
+        ao = ssao.ambient_occlusion(self.depth, normals=self.normals, camera=camera,
+                                    edge_colours=self.beauty)
         self.assert_same_bits(ao, run_cli("--ao-only", camera=camera)["AO"])
         self.assert_same_bits(ao, ssao.ambient_occlusion(self.depth, normals=self.normals,
-                                                         camera=self.camera, radius=0.5))
+                                                         camera=self.camera, radius=0.5,
+                                                         edge_colours=self.beauty))
 
     def test_composite(self):
         ao, composite = ssao.ambient_occlusion(self.depth, normals=self.normals,
@@ -184,7 +186,7 @@ class CameraRulesAgreeWithCli(unittest.TestCase):
         yield "matrix without projection_matrix", dict(camera, projection="matrix")
 
     def test_same_verdicts_and_bits(self):
-        depth, normals, _, camera = load_sample()
+        depth, normals, beauty, camera = load_sample()
         verdicts = {True: 0, False: 0}
         for name, variant in self.variants(camera):
             with self.subTest(name):
@@ -196,7 +198,7 @@ class CameraRulesAgreeWithCli(unittest.TestCase):
                     warnings.simplefilter("ignore")
                     try:
                         ao = ssao.ambient_occlusion(depth, normals=normals, camera=variant,
-                                                    radius=0.8)
+                                                    radius=0.8, edge_colours=beauty)
                     except ssao.SSAOError:
                         ao = None
                 self.assertEqual(ao is None, cli is None,
@@ -383,13 +385,15 @@ class SequenceOfFrames(unittest.TestCase):
     def sequence(self, first_frame=1, **parameters):
         with ssao.Sequence() as shot:
             return [shot.ambient_occlusion(self.depth, normals=self.normals, camera=camera,
-                                           radius=0.8, frame=first_frame + k, **parameters)
+                                           radius=0.8, edge_colours=self.beauty,
+                                           frame=first_frame + k, **parameters)
                     for k, camera in enumerate(self.cameras)]
 
     def test_frames_are_the_cli_sequence(self):
         cli = self.cli_sequence()
         alone = [ssao.ambient_occlusion(self.depth, normals=self.normals, camera=camera,
-                                        radius=0.8) for camera in self.cameras]
+                                        radius=0.8, edge_colours=self.beauty)
+                 for camera in self.cameras]
         for first_frame in (1, -1):  # Blender's frames may be negative
             aos = self.sequence(first_frame)
             for k in range(3):
@@ -403,7 +407,8 @@ class SequenceOfFrames(unittest.TestCase):
         for k, ao in enumerate(self.sequence(temporal_frames=1)):
             AgainstCli.assert_same_bits(self, ao, cli[k])
             AgainstCli.assert_same_bits(self, ao, ssao.ambient_occlusion(
-                self.depth, normals=self.normals, camera=self.cameras[k], radius=0.8))
+                self.depth, normals=self.normals, camera=self.cameras[k], radius=0.8,
+                edge_colours=self.beauty))
 
     def test_a_frame_again_uses_only_the_frames_before_it(self):
         with ssao.Sequence() as shot:
