@@ -6,6 +6,7 @@
 
 #include "scratch.h"
 #include "simd.h"
+#include "vec3.h"
 
 namespace ssao {
 
@@ -93,20 +94,18 @@ void pixel_filter(const Frame& frame, const Tile& around, const float* source, c
 namespace {
 
 // Two depths of different surfaces: a jump of more than kEdgeDepthJump of the nearer.
-bool depth_jump(float a, float b) { return std::fabs(a - b) > kEdgeDepthJump * std::min(a, b); }
-
-// The beauty's colour of frame pixel (x, y) into rgb, if that pixel is in the beauty and finite.
-bool beauty_colour(const ImageView& beauty, int x, int y, float* rgb) {
-  if (x < 0 || y < 0 || x >= beauty.width || y >= beauty.height) return false;
-  const float* p = beauty.pixel(x, y);
-  for (int c = 0; c < 3; ++c) {
-    rgb[c] = p[beauty.channels >= 3 ? c : 0];
-    if (!std::isfinite(rgb[c])) return false;
-  }
-  return true;
+inline bool depth_jump(float a, float b) {
+  return std::fabs(a - b) > kEdgeDepthJump * std::min(a, b);
 }
 
-float dot3(const float* a, const float* b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+// The beauty's colour of pixel (x, y) of the beauty, if it is inside it and finite.
+bool beauty_colour(const ImageView& beauty, int x, int y, Vec3& rgb) {
+  if (x < 0 || y < 0 || x >= beauty.width || y >= beauty.height) return false;
+  const float* p = beauty.pixel(x, y);
+  const bool grey = beauty.channels < 3;
+  rgb = {p[0], p[grey ? 0 : 1], p[grey ? 0 : 2]};
+  return std::isfinite(rgb.x) && std::isfinite(rgb.y) && std::isfinite(rgb.z);
+}
 
 // 1 where pixel i of a row has a depth jump to its right neighbour or to the pixel below it
 // (`below`: the next row, or the row itself on the last), else 0; background pixels read
@@ -116,10 +115,10 @@ float dot3(const float* a, const float* b) { return a[0] * b[0] + a[1] * b[1] + 
 SSAO_VECTORIZE void jump_row(const float* __restrict depth, const float* __restrict below,
                              int count, unsigned char* __restrict flags) {
   for (int i = 0; i < count; ++i) {
-    const float d = depth[i], right = depth[i + 1], down = below[i];
-    const bool across = std::fabs(d - right) > kEdgeDepthJump * std::min(d, right);
-    const bool under = std::fabs(d - down) > kEdgeDepthJump * std::min(d, down);
-    flags[i] = (across || under) ? 1 : 0;
+    // | on ints rather than ||: both tests always run, so the loop has no branch to keep it
+    // scalar (the SSE build vectorises it).
+    flags[i] = static_cast<unsigned char>(int(depth_jump(depth[i], depth[i + 1])) |
+                                          int(depth_jump(depth[i], below[i])));
   }
 }
 
@@ -128,7 +127,10 @@ SSAO_VECTORIZE void jump_row(const float* __restrict depth, const float* __restr
 void mix_edges_by_beauty(const Frame& frame, const ImageView& beauty, int dx, int dy,
                          const Tile& around, const float* source, const Tile& t, float weight,
                          float* out) {
-  const int source_width = around.x1 - around.x0, width = t.x1 - t.x0;
+  const int width = t.x1 - t.x0;
+  const auto source_at = [&](int x, int y) {
+    return source[size_t(y - around.y0) * size_t(around.x1 - around.x0) + size_t(x - around.x0)];
+  };
   const auto inside = [&](int x, int y) {
     return x >= 0 && y >= 0 && x < frame.width() && y < frame.height() && frame.is_geometry(x, y);
   };
@@ -178,31 +180,26 @@ void mix_edges_by_beauty(const Frame& frame, const ImageView& beauty, int dx, in
           depth_jump(frame.depth(nx, ny), frame.depth(nx + sx, ny + sy))) {
         continue;
       }
-      float own[3], other[3], mixed[3];
+      Vec3 own, other, mixed;
       if (!beauty_colour(beauty, x - sx - dx, y - sy - dy, own) ||
           !beauty_colour(beauty, nx + sx - dx, ny + sy - dy, other) ||
           !beauty_colour(beauty, x - dx, y - dy, mixed)) {
         continue;
       }
-      float difference[3], from_other[3];
-      for (int c = 0; c < 3; ++c) {
-        difference[c] = own[c] - other[c];
-        from_other[c] = mixed[c] - other[c];
-      }
-      const float contrast = dot3(difference, difference);
-      const float larger = std::max(dot3(own, own), dot3(other, other));
+      const Vec3 difference = own - other;
+      const float contrast = dot(difference, difference);
+      const float larger = std::max(dot(own, own), dot(other, other));
       if (!(contrast > 0.0f) || contrast < kEdgeColourContrast * kEdgeColourContrast * larger) {
         continue;
       }
-      const float beta = std::min(1.0f, std::max(0.0f, dot3(from_other, difference) / contrast));
+      const float beta = std::min(1.0f, std::max(0.0f, dot(mixed - other, difference) / contrast));
       if (!std::isfinite(beta)) continue;
       // Each surface's AO through the pixel filter, over the pixels around p on that surface
       // (without the filter, p's and n's own).
       const float side = weight, centre = 1.0f - 2.0f * weight;
       if (!(weight > 0.0f)) {
         out[size_t(y - t.y0) * width + (x - t.x0)] =
-            beta * source[size_t(y - around.y0) * source_width + (x - around.x0)] +
-            (1.0f - beta) * source[size_t(ny - around.y0) * source_width + (nx - around.x0)];
+            beta * source_at(x, y) + (1.0f - beta) * source_at(nx, ny);
         continue;
       }
       float own_sum = 0.0f, own_weight = 0.0f, other_sum = 0.0f, other_weight = 0.0f;
@@ -211,7 +208,7 @@ void mix_edges_by_beauty(const Frame& frame, const ImageView& beauty, int dx, in
         for (int qx = std::max(x - 1, around.x0); qx < std::min(x + 2, around.x1); ++qx) {
           if (!frame.is_geometry(qx, qy)) continue;
           const float w = (qx == x ? centre : side) * (qy == y ? centre : side);
-          const float ao = source[size_t(qy - around.y0) * source_width + (qx - around.x0)];
+          const float ao = source_at(qx, qy);
           const float d = frame.depth(qx, qy);
           if (!depth_jump(d, depth)) {
             own_sum += w * ao, own_weight += w;
