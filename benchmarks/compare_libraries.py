@@ -11,6 +11,8 @@ Reads Depth and Normal from a Blender multilayer EXR (as ssao_eval does), runs t
 the candidate in interleaved rounds (B C B C ...) after one untimed round each, and prints the
 median and fastest time of each, their ratio, and the largest AO difference between the two.
 --set applies to both libraries, --baseline-set / --candidate-set to one.
+The beauty (<layer>.Combined.R/G/B), when the file has one, is attached too, as the command
+line attaches it (edge_coverage reads it; --no-beauty leaves it out).
 --baseline-layers N / --candidate-layers N attach the scene's first N extra depth layers
 (<layer>.Depth2.Z with .Facing2.V, ..., as scripts/blender/render_layers.py writes them) to one
 library: with the same .so for both, the ratio is what the layers cost.
@@ -56,7 +58,10 @@ def read_passes(path):
         layers.append((np.ascontiguousarray(pixels[:, :, depth_index]),
                        None if facing_index is None
                        else np.ascontiguousarray(pixels[:, :, facing_index])))
-    return depth, normal, layers
+    colour = [next((i for i, n in enumerate(names) if n.endswith(f"Combined.{c}")), None)
+              for c in "RGB"]
+    beauty = None if None in colour else np.ascontiguousarray(pixels[:, :, colour])
+    return depth, normal, layers, beauty
 
 
 def camera_parameters(path):
@@ -74,7 +79,7 @@ def parse_sets(items):
 
 
 class Runner:
-    def __init__(self, path, params, depth, normal, layers, sequence=False):
+    def __init__(self, path, params, depth, normal, layers, beauty, sequence=False):
         self.lib = ssao.load_library(path)
         self.ao = np.zeros(depth.shape, np.float32)
         self.job = ssao.Job(self.lib)
@@ -95,6 +100,10 @@ class Runner:
             if facing is not None:
                 self.job.set_image(f"facing{hit}", facing)
         self.job.set_image("ao", self.ao)
+        if beauty is not None:  # with the composite, as the command line runs
+            self.composite = np.zeros(beauty.shape, np.float32)
+            self.job.set_image("beauty", beauty)
+            self.job.set_image("composite", self.composite)
         self.times = []
 
     def run(self, timed=True):
@@ -121,6 +130,8 @@ def main():
     parser.add_argument("--candidate-set", action="append", default=[])
     parser.add_argument("--baseline-layers", type=int, default=0, metavar="N")
     parser.add_argument("--candidate-layers", type=int, default=0, metavar="N")
+    parser.add_argument("--no-beauty", action="store_true",
+                        help="leave the scene's beauty (Combined) out")
     parser.add_argument("--sequence", action="store_true",
                         help="run each library's job as consecutive frames of a sequence "
                              "(parameter frame 0, 1, 2, ...): the cost of a frame whose "
@@ -129,7 +140,9 @@ def main():
     if args.repeat < 1:
         parser.error("--repeat must be at least 1")
 
-    depth, normal, layers = read_passes(args.scene)
+    depth, normal, layers, beauty = read_passes(args.scene)
+    if args.no_beauty:
+        beauty = None
     for flag, count in (("--baseline-layers", args.baseline_layers),
                         ("--candidate-layers", args.candidate_layers)):
         if not 0 <= count <= len(layers):
@@ -140,9 +153,11 @@ def main():
     candidate = args.candidate or os.path.join(os.path.dirname(os.path.abspath(__file__)), "..",
                                                "build", "lib", "libssao.so")
     runners = {"baseline": Runner(args.baseline, {**common, **parse_sets(args.baseline_set)},
-                                  depth, normal, layers[:args.baseline_layers], args.sequence),
+                                  depth, normal, layers[:args.baseline_layers], beauty,
+                                  args.sequence),
                "candidate": Runner(candidate, {**common, **parse_sets(args.candidate_set)},
-                                   depth, normal, layers[:args.candidate_layers], args.sequence)}
+                                   depth, normal, layers[:args.candidate_layers], beauty,
+                                   args.sequence)}
     for r in runners.values():
         r.run(timed=False)
     for _ in range(args.repeat):
@@ -151,7 +166,8 @@ def main():
     height, width = depth.shape
     print(f"frame {width}x{height}, threads {args.threads}, {args.repeat} interleaved rounds, "
           f"extra depth layers: baseline {args.baseline_layers}, "
-          f"candidate {args.candidate_layers}")
+          f"candidate {args.candidate_layers}; beauty "
+          f"{'attached (with the composite)' if beauty is not None else 'none'}")
     for name, r in runners.items():
         print(f"{name:9s} median {1e3 * statistics.median(r.times):9.2f} ms  "
               f"min {1e3 * min(r.times):9.2f} ms")
