@@ -923,6 +923,43 @@ class AddonTest(unittest.TestCase):
         np.testing.assert_allclose(ratio, factor_with[lit], atol=1e-4)
         self.assertLess(float(ao_with[lit].mean()), 0.97, "there is AO to keep")
 
+    def test_a_tree_that_exported_the_alpha_alone_exports_the_image(self):
+        # A file saved when the node's second exporter wrote the Image's alpha alone (through a
+        # Separate Color "SSAO Image Alpha"): rendered now, the exporter writes the Image's
+        # colours, which the node reads at depth edges, as the command-line tool reads them.
+        folder = self.folder("old_tree")
+        blend = self.blender.build_scene("old_tree/scene", *ONE_LAYER,
+                                         "--output", os.path.join(folder, "out_####.exr"),
+                                         "--passes-dir", os.path.join(folder, "passes"))
+        old = os.path.join(folder, "old.blend")
+        downgrade = (
+            "import bpy, sys\n"
+            "compute = next(m for n, m in sys.modules.items() "
+            "if n.endswith('ssao_compositor.compute'))\n"
+            "tree = compute.ssao_nodes(bpy.context.scene)[0].node_tree\n"
+            "group_in = next(n for n in tree.nodes if n.bl_idname == 'NodeGroupInput')\n"
+            "exporter = tree.nodes['SSAO Export Alpha']\n"
+            "alpha = tree.nodes.new('CompositorNodeSeparateColor')\n"
+            "alpha.name = 'SSAO Image Alpha'\n"
+            "tree.links.new(group_in.outputs['Image'], alpha.inputs[0])\n"
+            "tree.links.new(alpha.outputs['Alpha'], exporter.inputs[0])\n"
+            "compute.compat.set_image_format(exporter.format, 'OPEN_EXR', color_depth='32', "
+            "codec='ZIP', color_mode='RGB')\n"
+            f"bpy.ops.wm.save_as_mainfile(filepath={old!r})\n")
+        self.blender.run(blend, "--python-exit-code", "1", "--python-expr", downgrade)
+        log = self.render_frame(old, folder)
+        self.assertIn("with AO", log)
+        passes = read_exr(os.path.join(folder, "passes", "0001.exr"))
+        export = glob.glob(os.path.join(folder, "export", "image", "ssao_*0001.exr"))
+        self.assertEqual(len(export), 1, export)
+        image = read_exr(export[0])
+        for c in "RGBA":
+            np.testing.assert_allclose(image[c], passes[f"Image.{c}"], atol=1e-6, err_msg=c)
+        self.assertGreater(float(np.ptp(image["R"] - image["B"])), 0.05, "colours, not grey")
+        ao = passes["SSAO.V"] if "SSAO.V" in passes else passes["SSAO.R"]
+        cli = self.cli_ao(folder, os.path.join(folder, "scene.camera.json"))
+        np.testing.assert_allclose(ao, cli, atol=1e-5)
+
     def test_addon_enabled_after_loading_the_file(self):
         # blender -b file.blend --addons ...: the file is loaded before the add-on registers.
         folder = self.folder("late")
