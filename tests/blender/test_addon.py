@@ -51,6 +51,12 @@ def rgb(channels, prefix=""):
     return np.stack([channels[prefix + c] for c in "RGB"], axis=-1)
 
 
+def node_ao(passes):
+    """The node's AO in a render's passes file: SSAO.V where Blender wrote the float socket
+    as a value, else SSAO.R."""
+    return passes["SSAO.V"] if "SSAO.V" in passes else passes["SSAO.R"]
+
+
 def normal(channels, prefix):
     """A vector pass: X, Y, Z (a Render Result, 5.x's File Output), or R, G, B (3.4 and 4.3
     write a File Output's vector as a colour); None when there is none (the pass is off)."""
@@ -228,7 +234,7 @@ class AddonTest(unittest.TestCase):
         out = read_exr(output_exr)
         passes = read_exr(passes_exr)
         beauty = rgb(passes, "Image.")
-        ao = passes["SSAO.V"] if "SSAO.V" in passes else passes["SSAO.R"]
+        ao = node_ao(passes)
         assert_node_composite(rgb(out), beauty, ao, normal(passes, "Normal."))
         np.testing.assert_allclose(out["A"], passes["Image.A"], atol=1e-6)
         return ao, passes
@@ -244,15 +250,20 @@ class AddonTest(unittest.TestCase):
     # radius, writing the AO alone.
     CLI_ON_EXPORTS = ("--radius", "0.8", "--ao-only", "--quiet")
 
-    def cli_input(self, folder, frame):
-        """The node's exports of `frame` (Normal in RGB, Depth in A; the Image, in the image/
-        folder beside them) as one EXR with Blender's channel names, whose beauty the tool
-        reads for the edges (edge_coverage) as the node reads the Image: its path."""
+    def exports(self, folder, frame):
+        """The paths of the node's two exports of `frame`: its passes (Normal in RGB, Depth in
+        A) and the Image, in the image/ folder beside them under the same name."""
         export = glob.glob(os.path.join(folder, "export", f"ssao_*{frame:04d}.exr"))
         self.assertEqual(len(export), 1, export)
-        passes = read_exr(export[0])
-        image = read_exr(os.path.join(os.path.dirname(export[0]), "image",
-                                      os.path.basename(export[0])))
+        return export[0], os.path.join(os.path.dirname(export[0]), "image",
+                                       os.path.basename(export[0]))
+
+    def cli_input(self, folder, frame):
+        """The node's exports of `frame` as one EXR with Blender's channel names, whose beauty
+        the tool reads for the edges (edge_coverage) as the node reads the Image: its path."""
+        passes_path, image_path = self.exports(folder, frame)
+        passes = read_exr(passes_path)
+        image = read_exr(image_path)
         planes = {"ViewLayer.Depth.Z": passes["A"]}
         planes.update({f"ViewLayer.Normal.{a}": passes[c] for a, c in zip("XYZ", "RGB")})
         planes.update({f"ViewLayer.Combined.{c}": image[c] for c in "RGBA"})
@@ -352,7 +363,7 @@ class AddonTest(unittest.TestCase):
                 beauty = np.stack([passes[f"Image.{c}"] for c in "RGBA"], axis=-1)
                 cli, cli_ao = self.cli_composite(folder, os.path.join(folder, "scene.camera.json"),
                                                  passes)
-                ao = passes["SSAO.V"] if "SSAO.V" in passes else passes["SSAO.R"]
+                ao = node_ao(passes)
                 np.testing.assert_allclose(ao, cli_ao, atol=1e-5)  # the same AO
                 alpha = beauty[..., 3]
                 if film == "sky":
@@ -950,13 +961,11 @@ class AddonTest(unittest.TestCase):
         log = self.render_frame(old, folder)
         self.assertIn("with AO", log)
         passes = read_exr(os.path.join(folder, "passes", "0001.exr"))
-        export = glob.glob(os.path.join(folder, "export", "image", "ssao_*0001.exr"))
-        self.assertEqual(len(export), 1, export)
-        image = read_exr(export[0])
+        image = read_exr(self.exports(folder, 1)[1])
         for c in "RGBA":
             np.testing.assert_allclose(image[c], passes[f"Image.{c}"], atol=1e-6, err_msg=c)
         self.assertGreater(float(np.ptp(image["R"] - image["B"])), 0.05, "colours, not grey")
-        ao = passes["SSAO.V"] if "SSAO.V" in passes else passes["SSAO.R"]
+        ao = node_ao(passes)
         cli = self.cli_ao(folder, os.path.join(folder, "scene.camera.json"))
         np.testing.assert_allclose(ao, cli, atol=1e-5)
 
