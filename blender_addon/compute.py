@@ -563,7 +563,17 @@ def compute_frame(scene, frame, since=0.0, outcome="written", wait=True, sequenc
             node.status = f"Error: {error}"
             report(f"{scene.name} frame {frame} node '{node.name}': {outcome} WITHOUT AO: "
                    f"{error}", error=True)
+        finally:
+            if path is not None and _in_process_export_dir(path):
+                inner_tree.remove_earlier_exports(node, path)
     return done
+
+
+def _in_process_export_dir(path):
+    """Whether `path` is in this session's own export folder, whose exports only this session
+    reads: a folder the user chose keeps every frame, and the folder saved files point at is
+    shared with other sessions."""
+    return os.path.realpath(os.path.dirname(path)) == os.path.realpath(PROCESS_EXPORT_DIR)
 
 
 def compute_ao(scene=None, node=None, render=True):

@@ -180,6 +180,35 @@ def image_export_path(passes_path):
     return path
 
 
+def remove_earlier_exports(node, kept_path):
+    """Removes the node's exports of the frames before the one at `kept_path` (passes and
+    Image) from the folder that holds it: an animation adds them for each frame (about 25 MB
+    at 1920x1080), computes its frames in order, and reads none again once it is past it."""
+    folder, name = os.path.split(kept_path)
+    prefix = compat.file_output_target(inner(node, EXPORT_NODE))[1]
+
+    def frame_of(file_name):  # None for another file, or a still's (no number)
+        number = file_name[len(prefix):-len(".exr")]
+        return int(number) if file_name.startswith(prefix) and file_name.endswith(".exr") \
+            and number.isdigit() else None
+
+    kept = frame_of(name)
+    if kept is None:
+        return
+    for where in (folder, os.path.join(folder, IMAGE_FOLDER)):
+        try:
+            names = os.listdir(where)
+        except OSError:
+            continue
+        for other in names:
+            frame = frame_of(other)
+            if frame is not None and frame < kept:
+                try:
+                    os.remove(os.path.join(where, other))
+                except OSError:
+                    pass
+
+
 def point_exporter(node, folder):
     """Points the node's exporters at `folder` (no folder is made: File Output makes it when it
     first writes)."""

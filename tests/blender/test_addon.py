@@ -704,6 +704,32 @@ class AddonTest(unittest.TestCase):
             np.testing.assert_allclose(ao, aos[frame - 1], atol=1e-5, rtol=0,
                                        err_msg=f"chunk frame {frame}")
 
+    def test_an_animation_keeps_only_its_last_frames_exports(self):
+        # In the session's own export folder each frame's exports (passes and Image, about
+        # 25 MB at 1920x1080) are removed once a later frame is computed: a long animation
+        # must not fill $TMPDIR. The folder is listed from inside Blender (it goes when Blender
+        # quits) at each render_complete: the re-composites' and, last, the job's.
+        folder = self.folder("anim_exports")
+        blend = self.blender.build_scene("anim_exports/scene", *ONE_LAYER, "--frames", "3",
+                                         "--output", os.path.join(folder, "out_####.exr"),
+                                         "--passes-dir", os.path.join(folder, "passes"))
+        listing = ("import bpy, json, os, tempfile\n"
+                   "def listing(*_):\n"
+                   "    top = os.path.join(tempfile.gettempdir(),\n"
+                   "                       f'ssao_compositor_{os.getpid()}')\n"
+                   "    names = [os.path.relpath(os.path.join(where, name), top)\n"
+                   "             for where, _, files in os.walk(top) for name in files]\n"
+                   "    print('left:', json.dumps(sorted(names)))\n"
+                   "bpy.app.handlers.render_complete.append(listing)\n")
+        log = self.blender.run(blend, "--python-expr", listing, "-a")
+        self.assertEqual(log.count("with AO"), 3, log)
+        self.assert_frames_are_beauty_times_ao(folder, 3)
+        left = [line for line in log.splitlines() if line.startswith("left: ")][-1]
+        exports = sorted(name for name in json.loads(left[len("left: "):]) if "ssao_" in name)
+        self.assertEqual(len(exports), 2, left)
+        self.assertTrue(exports[0].startswith("image" + os.sep) and
+                        all(name.endswith("0003.exr") for name in exports), left)
+
     def test_a_farm_chunk_with_the_node_defaults_is_the_whole_shot(self):
         # The defaults' hidden surfaces and band: the frames before the chunk bring their
         # helper renders' layers too.
