@@ -35,6 +35,13 @@ def render_size(scene):
     return crop_window(scene.render)[2:]
 
 
+def render_threads(scene):
+    """The render's thread count when it is fixed (Render Properties > Performance), else 0:
+    every core."""
+    render = scene.render
+    return render.threads if render.threads_mode == 'FIXED' else 0
+
+
 def framed(settings, render, window):
     """Camera settings {name: value} (CROPPED's names) of the image `window` = (x0, y0, width,
     height), in the frame's pixels (y up from the bottom; it may reach beyond the frame: a guard

@@ -303,13 +303,6 @@ def without_ao(node, scene):
         report(f"node '{node.name}': resetting its AO to 1 failed: {error}", error=True)
 
 
-def threads(scene):
-    """The render's thread count when it is fixed (Render Properties > Performance), else 0:
-    every core."""
-    render = scene.render
-    return render.threads if render.threads_mode == 'FIXED' else 0
-
-
 class Sequences:
     """The frames of one animation render, computed in frame order (handlers.py: headless from
     render_init to render_complete; in the UI the frames written, after the job): an
@@ -430,7 +423,7 @@ def compute_node(node, scene, passes, wait=True, run_stats=None, sequences=None)
         output_window=(overscan, overscan, width, height) if overscan else None,
         require_geometry=False, run_stats=run_stats,
         **camera, background_depth=background,  # the same as the Normal check's
-        threads=threads(scene), **node_parameters(node))
+        threads=camera_module.render_threads(scene), **node_parameters(node))
     inner_tree.store_outputs(node, ao, composite)
     return ao
 

@@ -1093,14 +1093,14 @@ class AddonTest(unittest.TestCase):
 
     def test_threads_follow_a_fixed_render_thread_count(self):
         script = ("import bpy, sys\n"
-                  "compute = next(m for n, m in sys.modules.items() "
-                  "if n.endswith('ssao_compositor.compute'))\n"
+                  "camera = next(m for n, m in sys.modules.items() "
+                  "if n.endswith('ssao_compositor.camera'))\n"
                   "render = bpy.context.scene.render\n"
                   "render.threads_mode = 'AUTO'\n"
-                  "print('THREADS', compute.threads(bpy.context.scene))\n"
+                  "print('THREADS', camera.render_threads(bpy.context.scene))\n"
                   "render.threads_mode = 'FIXED'\n"
                   "render.threads = 3\n"
-                  "print('THREADS', compute.threads(bpy.context.scene))\n")
+                  "print('THREADS', camera.render_threads(bpy.context.scene))\n")
         log = self.blender.run("--python-exit-code", "1", "--python-expr", script)
         self.assertEqual(re.findall(r"^THREADS (\d+)$", log, re.M), ["0", "3"])
 
