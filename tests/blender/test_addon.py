@@ -211,13 +211,19 @@ class AddonTest(unittest.TestCase):
         os.makedirs(path, exist_ok=True)
         return path
 
-    def render_scene(self, name, *options):
-        """Builds scene `name` (build_ssao_scene.py options), renders frame 1 to an EXR, checks
-        that the frame equals beauty x the node's AO, and returns (folder, AO, passes)."""
+    def build_scene(self, name, *options):
+        """Builds scene `name` (build_ssao_scene.py options) in folder `name`, its frames
+        written to out_####.exr and its passes to passes/ there: returns (folder, .blend)."""
         folder = self.folder(name)
         blend = self.blender.build_scene(f"{name}/scene", *options,
                                          "--output", os.path.join(folder, "out_####.exr"),
                                          "--passes-dir", os.path.join(folder, "passes"))
+        return folder, blend
+
+    def render_scene(self, name, *options):
+        """Builds scene `name` (build_scene), renders frame 1, checks that the frame equals
+        beauty x the node's AO, and returns (folder, AO, passes)."""
+        folder, blend = self.build_scene(name, *options)
         log = self.render_frame(blend, folder)
         self.assertIn("with AO", log)
         ao, passes = self.assert_composite_is_beauty_times_ao(
@@ -648,10 +654,7 @@ class AddonTest(unittest.TestCase):
         self.assertLess(float(ao[~background].mean()), 0.97)
 
     def test_animation_renders_every_frame_with_its_own_ao(self):
-        folder = self.folder("anim")
-        blend = self.blender.build_scene("anim/scene", *ONE_LAYER, "--frames", "4",
-                                         "--output", os.path.join(folder, "out_####.exr"),
-                                         "--passes-dir", os.path.join(folder, "passes"))
+        folder, blend = self.build_scene("anim", *ONE_LAYER, "--frames", "4")
         # From frame 4 a marker binds a copy of the camera (same animation, same pose): a cut.
         cut = ("import bpy; s = bpy.context.scene; c = s.camera; d = c.copy(); "
                "s.collection.objects.link(d); s.timeline_markers.new('a', frame=1).camera = c; "
@@ -709,10 +712,7 @@ class AddonTest(unittest.TestCase):
         # 25 MB at 1920x1080) are removed once a later frame is computed: a long animation
         # must not fill $TMPDIR. The folder is listed from inside Blender (it goes when Blender
         # quits) at each render_complete: the re-composites' and, last, the job's.
-        folder = self.folder("anim_exports")
-        blend = self.blender.build_scene("anim_exports/scene", *ONE_LAYER, "--frames", "3",
-                                         "--output", os.path.join(folder, "out_####.exr"),
-                                         "--passes-dir", os.path.join(folder, "passes"))
+        folder, blend = self.build_scene("anim_exports", *ONE_LAYER, "--frames", "3")
         listing = ("import bpy, json, os, tempfile\n"
                    "def listing(*_):\n"
                    "    top = os.path.join(tempfile.gettempdir(),\n"
@@ -733,10 +733,7 @@ class AddonTest(unittest.TestCase):
     def test_a_farm_chunk_with_the_node_defaults_is_the_whole_shot(self):
         # The defaults' hidden surfaces and band: the frames before the chunk bring their
         # helper renders' layers too.
-        folder = self.folder("chunk_defaults")
-        blend = self.blender.build_scene("chunk_defaults/scene", "--frames", "3",
-                                         "--output", os.path.join(folder, "out_####.exr"),
-                                         "--passes-dir", os.path.join(folder, "passes"))
+        folder, blend = self.build_scene("chunk_defaults", "--frames", "3")
         self.blender.run(blend, "-a")
         passes = os.path.join(folder, "passes", "0003.exr")
         shot = self.assert_composite_is_beauty_times_ao(
@@ -873,10 +870,7 @@ class AddonTest(unittest.TestCase):
         self.ui_animation("ui_anim_layers", "--hidden-surfaces", "PEELED", "--overscan", "8")
 
     def ui_animation(self, name, *options):
-        folder = self.folder(name)
-        blend = self.blender.build_scene(f"{name}/scene", *options, "--frames", "4",
-                                         "--output", os.path.join(folder, "out_####.exr"),
-                                         "--passes-dir", os.path.join(folder, "passes"))
+        folder, blend = self.build_scene(name, *options, "--frames", "4")
         env = {"SSAO_COMPOSITOR_EXPORT_DIR": os.path.join(folder, "export")}
         log = self.blender.run_ui(blend, os.path.join(HERE, "ui_render_animation.py"),
                                   "--fail-frame", "4", env=env)
@@ -906,11 +900,8 @@ class AddonTest(unittest.TestCase):
         # one run; a hang fails the test (run_ui: stacks dumped, no retry). Every frame must
         # be written with its own AO.
         frames = UI_STRESS_FRAMES
-        folder = self.folder("ui_many")
-        blend = self.blender.build_scene("ui_many/scene", *ONE_LAYER, "--frames", str(frames),
-                                         "--samples", "4",
-                                         "--output", os.path.join(folder, "out_####.exr"),
-                                         "--passes-dir", os.path.join(folder, "passes"))
+        folder, blend = self.build_scene("ui_many", *ONE_LAYER, "--frames", str(frames),
+                                         "--samples", "4")
         env = {"SSAO_COMPOSITOR_EXPORT_DIR": os.path.join(folder, "export")}
         log = self.blender.run_ui(blend, os.path.join(HERE, "ui_render_animation.py"),
                                   "--timeout", str(60 + 2 * frames), env=env,
@@ -964,10 +955,7 @@ class AddonTest(unittest.TestCase):
         # A file saved when the node's second exporter wrote the Image's alpha alone (through a
         # Separate Color "SSAO Image Alpha"): rendered now, the exporter writes the Image's
         # colours, which the node reads at depth edges, as the command-line tool reads them.
-        folder = self.folder("old_tree")
-        blend = self.blender.build_scene("old_tree/scene", *ONE_LAYER,
-                                         "--output", os.path.join(folder, "out_####.exr"),
-                                         "--passes-dir", os.path.join(folder, "passes"))
+        folder, blend = self.build_scene("old_tree", *ONE_LAYER)
         old = os.path.join(folder, "old.blend")
         downgrade = (
             "import bpy, sys\n"
@@ -1130,7 +1118,6 @@ class AddonTest(unittest.TestCase):
         # before's), and inputs without depth or normals gave an AO of 1 or a wrong AO without
         # a word. Now each such frame must be the beauty exactly, with an AO output of 1, the
         # node's status and the log must say why, and the next frame must get its AO again.
-        folder = self.folder("broken")
         breaks = {2: ("depth unlinked", "the Depth input is not linked"),
                   3: ("normal from image", "the Normal input does not carry this render's "
                                            "normals"),
@@ -1139,9 +1126,7 @@ class AddonTest(unittest.TestCase):
                   8: ("radius nan", "the node's property 'radius' is nan"),
                   9: ("normal pass off", "Passes > Data > Normal"),
                   10: ("depth pass off", "Passes > Data > Z")}
-        blend = self.blender.build_scene("broken/scene", *ONE_LAYER, "--frames", "10",
-                                         "--output", os.path.join(folder, "out_####.exr"),
-                                         "--passes-dir", os.path.join(folder, "passes"))
+        folder, blend = self.build_scene("broken", *ONE_LAYER, "--frames", "10")
         report_path = os.path.join(folder, "report.json")
         log = self.render_frame(blend, folder, "--python",
                                 os.path.join(HERE, "render_broken_frames.py"), "--",
