@@ -556,17 +556,23 @@ def compute_frame(scene, frame, since=0.0, outcome="written", wait=True, sequenc
             node.status = f"Error: {error}"
             report(f"{scene.name} frame {frame} node '{node.name}': {outcome} WITHOUT AO: "
                    f"{error}", error=True)
-        finally:
-            if path is not None and _in_process_export_dir(path):
-                inner_tree.remove_earlier_exports(node, path)
+        if sequences is not None and path is not None:
+            _remove_earlier_exports(node, path)
     return done
 
 
-def _in_process_export_dir(path):
-    """Whether `path` is in this session's own export folder, whose exports only this session
-    reads: a folder the user chose keeps every frame, and the folder saved files point at is
-    shared with other sessions."""
-    return os.path.realpath(os.path.dirname(path)) == os.path.realpath(PROCESS_EXPORT_DIR)
+def _remove_earlier_exports(node, path):
+    """In an animation render (its frames computed in order) the node's exports of the frames
+    before the one at `path` are of no more use: removed, when they are in this session's own
+    export folder (a folder the user chose keeps every frame, and the one saved files point at
+    is shared with other sessions). A failure costs the frame nothing: it is reported."""
+    if os.path.realpath(os.path.dirname(path)) != os.path.realpath(PROCESS_EXPORT_DIR):
+        return
+    try:
+        inner_tree.remove_earlier_exports(node, path)
+    except Exception as error:
+        report(f"node '{node.name}': removing the exports of earlier frames failed: {error}",
+               error=True)
 
 
 def compute_ao(scene=None, node=None, render=True):

@@ -53,6 +53,9 @@ CACHED_PER_SCENE = 2
 # cores took 3.1 s and 1.4 GB more memory in blocks of 128 rows, against 6.8 s and 2.2 GB at
 # once (docs/blender.md, "Overhead per frame").
 SURFACE_BLOCK_ROWS = 128
+# Blocks ordered at once, at most: each holds ~190 bytes a pixel of intermediates (~110 MB for
+# 128 rows of a 4560 px wide helper frame), so more would bring back the whole frame's.
+SURFACE_MAX_THREADS = 8
 
 
 def forget(scene_name=None):
@@ -532,7 +535,8 @@ def surfaces(raw, hits, own_materials, threads=0):
     thickness rule stands for. A surface that stopped the ray (own_materials: the Depth pass
     beyond the AOVs' hits) is a front face. At most `hits` entries, twins included (a twin
     takes the place of a farther surface: with 5 entries rather than 3 the cut-out scene's
-    AO was no closer to Cycles', docs/blender.md). On `threads` threads (0: one per core)."""
+    AO was no closer to Cycles', docs/blender.md). On `threads` threads (0: one per core),
+    at most SURFACE_MAX_THREADS."""
     # Each pixel's list is its own, so blocks of rows give the same result: they spread over
     # the cores (numpy lets go of Python's lock), and their intermediates take the memory of
     # a block, not of the frame (SURFACE_BLOCK_ROWS).
@@ -540,7 +544,8 @@ def surfaces(raw, hits, own_materials, threads=0):
         return _block_surfaces({name: plane[top:top + SURFACE_BLOCK_ROWS]
                                 for name, plane in raw.items()}, hits, own_materials)
 
-    with concurrent.futures.ThreadPoolExecutor(threads or os.cpu_count() or 1) as pool:
+    workers = min(multilayer.thread_count(threads), SURFACE_MAX_THREADS)
+    with concurrent.futures.ThreadPoolExecutor(workers) as pool:
         blocks = list(pool.map(block, range(0, raw["hit0"].shape[0], SURFACE_BLOCK_ROWS)))
     depth, facing, normal = zip(*blocks)
     return (np.concatenate(depth, axis=1), np.concatenate(facing, axis=1),

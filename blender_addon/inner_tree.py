@@ -190,7 +190,7 @@ def remove_earlier_exports(node, kept_path):
     def frame_of(file_name):  # None for another file, or a still's (no number)
         number = file_name[len(prefix):-len(".exr")]
         return int(number) if file_name.startswith(prefix) and file_name.endswith(".exr") \
-            and number.isdigit() else None
+            and number.isascii() and number.isdigit() else None
 
     kept = frame_of(name)
     if kept is None:
