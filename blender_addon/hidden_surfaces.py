@@ -497,7 +497,7 @@ def _render(helper, path):
 def _planes(path, hits, own_materials, threads=0):
     """{aov or pass name: (height, width[, channels]) float32 array, row 0 on top} of the saved
     file, read on `threads` threads (0: one per core)."""
-    planes, _ = multilayer.read(path, threads or None)
+    planes, _ = multilayer.read(path, threads)
     names = _aov_names(hits) + (["Depth", "Normal"] if own_materials else [])
     layers = {}
     for aov in names:
@@ -640,6 +640,7 @@ def render_layers(scene, hits=MAX_HITS, overscan=0, folder=None, camera_matrix=N
     if layers is not None:
         return layers
     own_materials = any(_needs_own(m) for m in _editable_materials())
+    threads = camera_module.render_threads(scene)
     helper, group = helper_scene(scene, hits, overscan, own_materials, camera_matrix)
     folder = folder or bpy.app.tempdir
     os.makedirs(folder, exist_ok=True)
@@ -652,12 +653,11 @@ def render_layers(scene, hits=MAX_HITS, overscan=0, folder=None, camera_matrix=N
                     _render(helper, path)
             else:
                 _render(helper, path)
-        raw = _planes(path, hits, own_materials, camera_module.render_threads(scene))
+        raw = _planes(path, hits, own_materials, threads)
     finally:
         if os.path.exists(path):
             os.remove(path)
-    depth, facing, normal = surfaces(raw, hits, own_materials,
-                                     camera_module.render_threads(scene))
+    depth, facing, normal = surfaces(raw, hits, own_materials, threads)
     layers = {"depth": depth[0], "normal": normal}
     for k in range(2, hits + 1):
         layers[f"depth{k}"] = depth[k - 1]

@@ -168,13 +168,13 @@ def thread_count(threads=None):
         return threads
     try:
         return len(os.sched_getaffinity(0))
-    except AttributeError:  # not on Windows
+    except AttributeError:  # Windows and macOS have no affinity call
         return os.cpu_count() or 1
 
 
 def read(path, threads=None):
     """{channel name: (height, width) float32 array, row 0 on top} of every part, and the
-    first part's attributes. The chunks decode on `threads` threads (None: one per core)."""
+    first part's attributes. The chunks decode on `threads` threads (None or 0: one per core)."""
     with open(path, "rb") as f:
         data = f.read()
     try:
