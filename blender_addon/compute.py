@@ -4,6 +4,7 @@ import functools
 import json
 import math
 import os
+import secrets
 import tempfile
 import time
 import types
@@ -17,9 +18,12 @@ from . import compat, helper_process, hidden_surfaces, inner_tree, session, ssao
 # Where exporters write (per process; $SSAO_COMPOSITOR_EXPORT_DIR or the add-on's preference
 # override it, e.g. to keep the passes for the command-line tool). Saved files carry
 # SAVED_EXPORT_DIR instead, a folder that exists for any session on the machine, with or
-# without the add-on.
+# without the add-on. The process id alone does not name a session: Blender processes in
+# containers sharing one $TMPDIR (a farm's scratch) can have the same one, and this folder's
+# files are removed (earlier frames, and all of it when Blender quits); hence the random part.
 SAVED_EXPORT_DIR = os.path.join(tempfile.gettempdir(), "ssao_compositor")
-PROCESS_EXPORT_DIR = os.path.join(tempfile.gettempdir(), f"ssao_compositor_{os.getpid()}")
+PROCESS_EXPORT_DIR = os.path.join(tempfile.gettempdir(),
+                                  f"ssao_compositor_{os.getpid()}_{secrets.token_hex(8)}")
 # EEVEE writes its Depth pass as half floats with 65504 (the largest half) on the background
 # in 3.x; 4.x writes the clip end and 5.x 1e10, which the camera's clip_end covers, so setting
 # 65504 for every EEVEE render is harmless there.

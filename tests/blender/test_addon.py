@@ -712,16 +712,27 @@ class AddonTest(unittest.TestCase):
         # 25 MB at 1920x1080) are removed once a later frame is computed: a long animation
         # must not fill $TMPDIR. The folder is listed from inside Blender (it goes when Blender
         # quits) at each render_complete: the re-composites' and, last, the job's.
+        # Another Blender with the same process id (a container sharing $TMPDIR) has its own
+        # folder, named by that id as the session's once was: it keeps its files, also when
+        # this session quits.
         folder, blend = self.build_scene("anim_exports", *ONE_LAYER, "--frames", "3")
-        listing = ("import bpy, json, os, tempfile\n"
+        listing = ("import bpy, glob, json, os, tempfile\n"
+                   "prefix = os.path.join(tempfile.gettempdir(),\n"
+                   "                      f'ssao_compositor_{os.getpid()}')\n"
+                   "os.makedirs(prefix, exist_ok=True)\n"
+                   "open(os.path.join(prefix, 'other_session_0001.exr'), 'w').close()\n"
+                   "print('other session:', prefix)\n"
                    "def listing(*_):\n"
-                   "    top = os.path.join(tempfile.gettempdir(),\n"
-                   "                       f'ssao_compositor_{os.getpid()}')\n"
+                   "    top, = glob.glob(prefix + '_*')\n"
                    "    names = [os.path.relpath(os.path.join(where, name), top)\n"
                    "             for where, _, files in os.walk(top) for name in files]\n"
                    "    print('left:', json.dumps(sorted(names)))\n"
                    "bpy.app.handlers.render_complete.append(listing)\n")
         log = self.blender.run(blend, "--python-expr", listing, "-a")
+        other = [line for line in log.splitlines() if line.startswith("other session: ")][0]
+        other = other[len("other session: "):]
+        self.addCleanup(shutil.rmtree, other, ignore_errors=True)
+        self.assertEqual(os.listdir(other), ["other_session_0001.exr"], log)
         self.assertEqual(log.count("with AO"), 3, log)
         self.assert_frames_are_beauty_times_ao(folder, 3)
         left = [line for line in log.splitlines() if line.startswith("left: ")][-1]
