@@ -192,8 +192,25 @@ void mix_edges_by_beauty(const Frame& frame, const ImageView& beauty, int dx, in
       if (!(contrast > 0.0f) || contrast < kEdgeColourContrast * kEdgeColourContrast * larger) {
         continue;
       }
-      const float beta = std::min(1.0f, std::max(0.0f, dot(mixed - other, difference) / contrast));
-      if (!std::isfinite(beta)) continue;
+      // p and n are mixes of the two surfaces (n mostly B's), so their colours lie on the line
+      // from B to A, and n's between them. Where one lies well off (a highlight on a board's
+      // front edge, another face of the same object beyond n), A and B are not the colours of
+      // p's and n's surfaces: no mix.
+      const float tolerance = kEdgeColourTolerance * kEdgeColourTolerance * contrast;
+      const auto share_on_line = [&](const Vec3& colour, float& share) {
+        share = dot(colour - other, difference) / contrast;
+        const Vec3 off = colour - other - difference * share;
+        return dot(off, off) <= tolerance;
+      };
+      Vec3 neighbour;
+      float beta = 0.0f, neighbour_share = 0.0f;
+      if (!beauty_colour(beauty, nx - dx, ny - dy, neighbour) ||
+          !share_on_line(neighbour, neighbour_share) || !share_on_line(mixed, beta) ||
+          !(neighbour_share >= -kEdgeColourTolerance &&
+            neighbour_share <= 1.0f + kEdgeColourTolerance)) {
+        continue;
+      }
+      beta = std::min(1.0f, std::max(0.0f, beta));
       // Each surface's AO through the pixel filter, over the pixels around p on that surface
       // (without the filter, p's and n's own).
       const float side = weight, centre = 1.0f - 2.0f * weight;

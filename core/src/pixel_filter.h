@@ -32,17 +32,20 @@ Tile pixel_filter_source(const Frame& frame, const Tile& t);
 // coverage-weighted mix of both surfaces' colours, and so is its AO pass. Where pixel p of tile t
 // has a depth jump (more than kEdgeDepthJump relative) to a 4-neighbour n, and the pixel beyond p
 // on its own surface and the one beyond n on n's show colours A and B that differ enough to read a
-// mix (|A - B| at least kEdgeColourContrast x the larger of |A|, |B|), p's share of its own surface
-// is beta = (C - B) . (A - B) / |A - B|^2 (clamped to [0, 1], C p's colour) and out(p) = beta AO_p
-// + (1 - beta) AO_n, where AO_p and AO_n are the pixel filter (weight w) over the pixels around p
-// on p's and on n's surface alone, from `source` (tile `around`, as for pixel_filter). Elsewhere
-// out is left as it is. `beauty` has the output window's size: frame pixel (x, y) is its pixel (x -
-// dx, y - dy); its first three channels are read (one channel: grey). A jump to the sky does not
-// count (the normal pass's coverage handles it).
+// mix (|A - B| at least kEdgeColourContrast x the larger of |A|, |B|), and the colours C of p and
+// N of n lie on the line through B and A, N between them (each within kEdgeColourTolerance x
+// |A - B| of it; else A and B are not the colours of p's and n's surfaces, e.g. a highlight on
+// n), p's share of its own surface is beta = (C - B) . (A - B) / |A - B|^2 (clamped to [0, 1])
+// and out(p) = beta AO_p + (1 - beta) AO_n, where AO_p and AO_n are the pixel filter (weight w)
+// over the pixels around p on p's and on n's surface alone, from `source` (tile `around`, as for
+// pixel_filter). Elsewhere out is left as it is. `beauty` has the output window's size: frame pixel
+// (x, y) is its pixel (x - dx, y - dy); its first three channels are read (one channel: grey). A
+// jump to the sky does not count (the normal pass's coverage handles it).
 void mix_edges_by_beauty(const Frame& frame, const ImageView& beauty, int dx, int dy,
                          const Tile& around, const float* source, const Tile& t, float weight,
                          float* out);
 constexpr float kEdgeDepthJump = 0.05f;
 constexpr float kEdgeColourContrast = 0.5f;
+constexpr float kEdgeColourTolerance = 0.25f;
 
 }  // namespace ssao
