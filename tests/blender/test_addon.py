@@ -909,15 +909,21 @@ class AddonTest(unittest.TestCase):
         # saving a frame's passes from the render thread deadlocked Blender 5.2 against the
         # render window's drawing in about 1 animation render in 10. UI_STRESS_FRAMES frames in
         # one run; a hang fails the test (run_ui: stacks dumped, no retry). Every frame must
-        # be written with its own AO.
+        # be written with its own AO. In the session's own export folder (the default) the
+        # frames computed after the job leave their last frame's exports alone.
         frames = UI_STRESS_FRAMES
         folder, blend = self.build_scene("ui_many", *ONE_LAYER, "--frames", str(frames),
                                          "--samples", "4")
-        env = {"SSAO_COMPOSITOR_EXPORT_DIR": os.path.join(folder, "export")}
         log = self.blender.run_ui(blend, os.path.join(HERE, "ui_render_animation.py"),
-                                  "--timeout", str(60 + 2 * frames), env=env,
+                                  "--timeout", str(60 + 2 * frames),
                                   timeout=120 + 2 * frames)  # 0.3-0.8 s a frame measured
         self.assertRegex(log, r"ui_render_animation \[ *[0-9.]+s\] done")
+        exports, left = re.search(r"exports left in (.*): (\[.*\])$", log, re.M).groups()
+        self.addCleanup(shutil.rmtree, exports, ignore_errors=True)  # no atexit in run_ui
+        self.assertRegex(os.path.basename(exports), r"^ssao_compositor_[0-9]+_[0-9a-f]{16}$")
+        left = [name for name in json.loads(left) if "ssao_" in name]
+        self.assertEqual(len(left), 2, left)
+        self.assertTrue(all(name.endswith(f"{frames:04d}.exr") for name in left), left)
         self.assertEqual(log.count("with AO"), frames, log)
         self.assertNotIn("saving the passes failed", log)
         aos = self.assert_frames_are_beauty_times_ao(folder, frames)

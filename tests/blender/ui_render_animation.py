@@ -9,11 +9,14 @@ then quits. Run under Xvfb by tests/blender/test_addon.py:
 --fail-frame N: the SSAO nodes start with an AO of 0.5 (one left by an earlier render), and the
 library fails on frame N, whose file must then get no AO at all, not that one nor another
 frame's. Prints "ui_render_animation [...] done" when everything finished, and exits non-zero on
-a timeout or an exception.
+a timeout or an exception. Before that it prints the add-on's export folder and the files left
+in it ("exports left in FOLDER: [names]"): Blender quits without its atexit functions here.
 
 Also probes, from a panel's draw() (where Blender refuses data-block writes), whether the add-on's
 handlers.with_writes() can still write, and prints "read-only draw: direct write refused: ..."
 and "read-only draw: with_writes wrote: ..." (see handlers.py for why the timers need it)."""
+import json
+import os
 import sys
 import time
 import traceback
@@ -106,10 +109,16 @@ def show_render_properties():
 def quit_blender(code):
     log(f"read-only draw: direct {PROBE.get('direct', 'not drawn')}")
     log(f"read-only draw: with_writes {PROBE.get('with_writes', 'not drawn')}")
+    try:
+        folder = addon_module("compute").export_dir()
+        names = sorted(os.path.relpath(os.path.join(where, name), folder)
+                       for where, _, files in os.walk(folder) for name in files)
+        log(f"exports left in {folder}: {json.dumps(names)}")
+    except Exception as error:
+        log(f"exports left: cannot list them: {error}")
     log("done" if code == 0 else "failed")
     sys.stdout.flush()
     # os._exit skips Blender's own shutdown, which can hang under Xvfb; files are written.
-    import os
     os._exit(code)
 
 
