@@ -405,12 +405,13 @@ TEST(Analytic, PixelFilterMixesBothSurfacesAtEdgesAsASupersampledRender) {
 // silhouette are white (a bevel catching the light, one pixel wide).
 std::vector<float> board_beauty(const SlantedBoard& b, bool highlight) {
   const Scene& s = b.s;
+  constexpr double kBoardBehind = 5.45;  // depth between the board (5 to 5.3) and the wall (5.6)
   const auto colour_at = [&](int i, int j, int c) {
     V3 o, d, normal{0, 0, 0};
     b.cam.ray_at((i + 0.5) / b.kSub, (j + 0.5) / b.kSub, o, d);
-    const bool board = -(o + d * first_hit(b.solids, o, d, normal)).z < 5.45;
+    const bool board = -(o + d * first_hit(b.solids, o, d, normal)).z < kBoardBehind;
     const size_t pixel = b.index(i / b.kSub, j / b.kSub);
-    if (board && highlight && b.edge[pixel] && s.depth[pixel] < 5.45f) return 1.0;
+    if (board && highlight && b.edge[pixel] && s.depth[pixel] < kBoardBehind) return 1.0;
     static constexpr double kBoard[3] = {0.8, 0.25, 0.1}, kWall[3] = {0.15, 0.3, 0.7};
     return board ? kBoard[c] : kWall[c];
   };
