@@ -610,8 +610,8 @@ void Job::run() {
         }
       }
       if (edges_from_beauty) {
-        mix_edges_by_beauty(frame, edge_colours, dx, dy, around, resolved.data(), t, filter_weight,
-                            denoised.data());
+        mix_edges_by_beauty(frame, edge_colours, normal_, dx, dy, around, resolved.data(), t,
+                            filter_weight, denoised.data());
       }
     } else {
       resolve(t, denoised.data());

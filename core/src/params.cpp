@@ -146,7 +146,8 @@ const std::vector<Param>& params() {
                   "depths at or beyond this are background (Blender writes 1e10)"),
       string_param(kInput, "edge_coverage", "beauty", "none|beauty",
                    "beauty: at a depth edge, where the \"beauty\" image is attached and the two "
-                   "surfaces' colours differ enough and the edge's pixels show mixes of them, the "
+                   "surfaces' colours differ enough and the edge's pixels show mixes of them "
+                   "(and of their normals, where the \"normal\" image is attached), the "
                    "pixel's AO is the two surfaces' AO "
                    "(each through the pixel filter) mixed by the share of the pixel each covers, "
                    "read from the anti-aliased beauty (or the \"edge_colours\" image in its "

@@ -122,11 +122,25 @@ SSAO_VECTORIZE void jump_row(const float* __restrict depth, const float* __restr
   }
 }
 
+// Whether normal m (of a pixel of the Normal pass, filtered over it like the beauty) is a mix of
+// normals a and b: within kEdgeNormalTolerance of the segment between them. NaN: no.
+bool normal_is_mix(const Vec3& m, const Vec3& a, const Vec3& b) {
+  const Vec3 ab = a - b;
+  const float length_squared = dot(ab, ab);
+  const float share = length_squared > 1e-12f ? dot(m - b, ab) / length_squared : 0.0f;
+  const Vec3 off = m - b - ab * std::min(1.0f, std::max(0.0f, share));
+  return dot(off, off) <= kEdgeNormalTolerance * kEdgeNormalTolerance;
+}
+
 }  // namespace
 
-void mix_edges_by_beauty(const Frame& frame, const ImageView& beauty, int dx, int dy,
-                         const Tile& around, const float* source, const Tile& t, float weight,
-                         float* out) {
+void mix_edges_by_beauty(const Frame& frame, const ImageView& beauty, const ImageView& normal,
+                         int dx, int dy, const Tile& around, const float* source, const Tile& t,
+                         float weight, float* out) {
+  const auto normal_at = [&](int x, int y) {
+    const float* n = normal.pixel(x, y);
+    return Vec3{n[0], n[1], n[2]};
+  };
   const int width = t.x1 - t.x0;
   const auto source_at = [&](int x, int y) {
     return source[size_t(y - around.y0) * size_t(around.x1 - around.x0) + size_t(x - around.x0)];
@@ -208,6 +222,10 @@ void mix_edges_by_beauty(const Frame& frame, const ImageView& beauty, int dx, in
           !share_on_line(neighbour, neighbour_share) || !share_on_line(mixed, beta) ||
           !(neighbour_share >= -kEdgeColourTolerance &&
             neighbour_share <= 1.0f + kEdgeColourTolerance)) {
+        continue;
+      }
+      if (normal.attached() &&
+          !normal_is_mix(normal_at(x, y), normal_at(x - sx, y - sy), normal_at(nx + sx, ny + sy))) {
         continue;
       }
       beta = std::min(1.0f, std::max(0.0f, beta));

@@ -38,14 +38,20 @@ Tile pixel_filter_source(const Frame& frame, const Tile& t);
 // n), p's share of its own surface is beta = (C - B) . (A - B) / |A - B|^2 (clamped to [0, 1])
 // and out(p) = beta AO_p + (1 - beta) AO_n, where AO_p and AO_n are the pixel filter (weight w)
 // over the pixels around p on p's and on n's surface alone, from `source` (tile `around`, as for
-// pixel_filter). Elsewhere out is left as it is. `beauty` has the output window's size: frame pixel
-// (x, y) is its pixel (x - dx, y - dy); its first three channels are read (one channel: grey). A
-// jump to the sky does not count (the normal pass's coverage handles it).
-void mix_edges_by_beauty(const Frame& frame, const ImageView& beauty, int dx, int dy,
-                         const Tile& around, const float* source, const Tile& t, float weight,
-                         float* out);
+// pixel_filter). Where the Normal pass is given (`normal`, the depth image's size: frame pixel
+// (x, y) is its pixel (x, y); unattached: no such test), p's normal must also be a mix of the
+// normals beyond p and beyond n (within kEdgeNormalTolerance of the segment between them): else p
+// holds a third surface too small to show elsewhere (the top of a board seen at a grazing angle,
+// a sliver in a pixel), whose colour the two-colour model would read as one of the two.
+// Elsewhere out is left as it is. `beauty` has the output window's size: frame pixel (x, y) is
+// its pixel (x - dx, y - dy); its first three channels are read (one channel: grey). A jump to
+// the sky does not count (the normal pass's coverage handles it).
+void mix_edges_by_beauty(const Frame& frame, const ImageView& beauty, const ImageView& normal,
+                         int dx, int dy, const Tile& around, const float* source, const Tile& t,
+                         float weight, float* out);
 constexpr float kEdgeDepthJump = 0.05f;
 constexpr float kEdgeColourContrast = 0.5f;
 constexpr float kEdgeColourTolerance = 0.25f;
+constexpr float kEdgeNormalTolerance = 0.3f;
 
 }  // namespace ssao

@@ -289,18 +289,19 @@ TEST(Analytic, PerspectiveAndOrthographicAgree) {
 // renderer's anti-aliased AO pass mixes the board's and the wall's AO on those pixels where the
 // Depth pass holds one of them; the reference does too: ray-traced AO at 3 x 3 points a pixel,
 // weighted by a Gaussian pixel filter of standard deviation 0.5 px (truncated at 1.5 px).
+// `below`: how far the board's centre lies below the view axis; `wall`: the wall's depth;
+// `half_height`: half the board's height; `degrees`: its turn about the view axis.
 struct SlantedBoard {
-  SlantedBoard() {
-    const double turn = 20.0 * M_PI / 180.0;
+  explicit SlantedBoard(double below = 0.0, double wall = 5.6, double half_height = 0.6,
+                        double degrees = 20.0) {
+    const double turn = degrees * M_PI / 180.0;
     const V3 across{std::cos(turn), std::sin(turn), 0}, up{-std::sin(turn), std::cos(turn), 0};
-    const V3 towards{0, 0, 1}, centre{0, 0, -5.15};  // front face at depth 5, the wall at 5.6
-    const Solid board = {{centre + across * 1.2, across},
-                         {centre - across * 1.2, across * -1.0},
-                         {centre + up * 0.6, up},
-                         {centre - up * 0.6, up * -1.0},
-                         {centre + towards * 0.15, towards},
-                         {centre - towards * 0.15, towards * -1.0}};
-    solids = {board, {{{0, 0, -5.6}, towards}}};
+    const V3 towards{0, 0, 1}, centre{0, -below, -5.15};  // front face at depth 5
+    board = {{centre + across * 1.2, across},    {centre - across * 1.2, across * -1.0},
+             {centre + up * half_height, up},    {centre - up * half_height, up * -1.0},
+             {centre + towards * 0.15, towards}, {centre - towards * 0.15, towards * -1.0}};
+    solids = {board, {{{0, 0, -wall}, towards}}};
+    behind = 0.5 * (5.3 + wall);
     s = ray_cast(cam, solids);
     // Pixels with a depth jump of more than 5 % to a 4-neighbour (both surfaces geometry).
     edge.assign(s.depth.size(), 0);
@@ -315,6 +316,12 @@ struct SlantedBoard {
     sub_ao.assign(s.depth.size() * kSub * kSub, -1.0);
   }
   size_t index(int x, int y) const { return size_t(y) * s.width + x; }
+  // Depth and normal of the surface at sub-pixel point (i + 0.5) / 3 on each axis.
+  double hit_at(int i, int j, V3& normal) const {
+    V3 o, d;
+    cam.ray_at((i + 0.5) / kSub, (j + 0.5) / kSub, o, d);
+    return -(o + d * first_hit(solids, o, d, normal)).z;
+  }
   // Ray-traced AO at sub-pixel point (i + 0.5) / 3 on each axis (column i, row j), computed once.
   double ao_at(int i, int j) {
     double& value = sub_ao[size_t(j) * s.width * kSub + i];
@@ -360,7 +367,9 @@ struct SlantedBoard {
   static constexpr int kSub = 3;
   const Camera cam;
   const double radius = 1.0;
+  Solid board;
   std::vector<Solid> solids;
+  double behind = 0;  // a depth between the board's back (5.3) and the wall
   Scene s;
   std::vector<char> edge;
   std::vector<double> sub_ao;
@@ -405,13 +414,11 @@ TEST(Analytic, PixelFilterMixesBothSurfacesAtEdgesAsASupersampledRender) {
 // silhouette are white (a bevel catching the light, one pixel wide).
 std::vector<float> board_beauty(const SlantedBoard& b, bool highlight) {
   const Scene& s = b.s;
-  constexpr double kBoardBehind = 5.45;  // depth between the board (5 to 5.3) and the wall (5.6)
   const auto colour_at = [&](int i, int j, int c) {
-    V3 o, d, normal{0, 0, 0};
-    b.cam.ray_at((i + 0.5) / b.kSub, (j + 0.5) / b.kSub, o, d);
-    const bool board = -(o + d * first_hit(b.solids, o, d, normal)).z < kBoardBehind;
+    V3 normal{0, 0, 0};
+    const bool board = b.hit_at(i, j, normal) < b.behind;
     const size_t pixel = b.index(i / b.kSub, j / b.kSub);
-    if (board && highlight && b.edge[pixel] && s.depth[pixel] < kBoardBehind) return 1.0;
+    if (board && highlight && b.edge[pixel] && s.depth[pixel] < b.behind) return 1.0;
     static constexpr double kBoard[3] = {0.8, 0.25, 0.1}, kWall[3] = {0.15, 0.3, 0.7};
     return board ? kBoard[c] : kWall[c];
   };
@@ -425,6 +432,25 @@ std::vector<float> board_beauty(const SlantedBoard& b, bool highlight) {
     }
   }
   return beauty;
+}
+
+// The board's Normal pass as a renderer filters it, like the beauty: on an edge the average of
+// the normals the pixel's footprint sees (view space, 3 per pixel).
+std::vector<float> board_normals(const SlantedBoard& b) {
+  const Scene& s = b.s;
+  std::vector<float> normals = s.normal;
+  for (int y = 1; y + 1 < s.height; ++y) {
+    for (int x = 1; x + 1 < s.width; ++x) {
+      for (int c = 0; c < 3; ++c) {
+        normals[b.index(x, y) * 3 + c] = float(b.filtered(x, y, [&](int i, int j) {
+          V3 normal{0, 0, 0};
+          b.hit_at(i, j, normal);
+          return c == 0 ? normal.x : c == 1 ? normal.y : normal.z;
+        }));
+      }
+    }
+  }
+  return normals;
 }
 
 // Where the Depth pass holds one surface, the beauty says how much of the pixel each covers
@@ -510,6 +536,82 @@ TEST(Analytic, BeautyCoverageLeavesEdgesWhoseColoursDoNotMix) {
       "pixel filter, %.4f with the beauty's coverage\n",
       edges, filtered_rmse, mixed_rmse);
   EXPECT_LT(mixed_rmse, 1.02 * filtered_rmse);
+}
+
+// A shelf board 11 cm high below the eye, 2 cm before a wall, turned 5 degrees: its top face,
+// in the crease against the wall, shows only as a sliver of the wall's pixels above the board
+// (under a pixel), red like the front face. The colours read such a pixel as part board, and
+// the board's AO there (its open front face) makes it too light; the Normal pass, filtered over
+// the pixel like the beauty, holds the top face's normal too, which is no mix of the front's and
+// the wall's: there the pixel filter alone stands. Where a pixel holds the two surfaces alone
+// (the slanted board of the tests above, its faces parallel to the wall), the filtered Normal
+// pass leaves the colours' coverage as it was.
+TEST(Analytic, BeautyCoverageLeavesPixelsThatHoldAThirdSurface) {
+  SlantedBoard b(0.5, 5.32, 0.055, 5.0);
+  Scene& s = b.s;
+  const std::vector<float> beauty = board_beauty(b, false), normals = board_normals(b);
+  std::vector<char> sliver(s.depth.size(), 0);  // wall pixels that hold some of the top face
+  for (int y = 1; y + 1 < s.height; ++y) {
+    for (int x = 1; x + 1 < s.width; ++x) {
+      if (!b.edge[b.index(x, y)] || !(s.depth[b.index(x, y)] > b.behind)) continue;
+      for (int j = y * b.kSub; j < (y + 1) * b.kSub; ++j) {
+        for (int i = x * b.kSub; i < (x + 1) * b.kSub; ++i) {
+          V3 normal{0, 0, 0};
+          b.hit_at(i, j, normal);
+          if (dot(normal, b.board[2].normal) > 0.99) sliver[b.index(x, y)] = 1;
+        }
+      }
+    }
+  }
+  const auto with = [&](SlantedBoard& board, const char* coverage, std::vector<float> colours,
+                        const std::vector<float>& normal) {
+    board.s.normal = normal;
+    return compute_ao(board.s, board.cam, board.radius, "hemisphere", true, [&](Job& j) {
+      j.set("resolution", "full");
+      j.set("edge_coverage", coverage);
+      j.image("beauty", colours, board.s.width, board.s.height, 3);
+    });
+  };
+  const std::vector<float> centre_normals = s.normal;
+  const auto sliver_rmse = [&](const std::vector<float>& ao) {
+    double sum_sq = 0;
+    int count = 0;
+    for (int y = 2; y + 2 < s.height; ++y) {
+      for (int x = 2; x + 2 < s.width; ++x) {
+        if (!sliver[b.index(x, y)]) continue;
+        const double reference = b.filtered(x, y, [&](int i, int j) { return b.ao_at(i, j); });
+        sum_sq += std::pow(ao[b.index(x, y)] - reference, 2);
+        ++count;
+      }
+    }
+    EXPECT_GE(count, 12);
+    return std::sqrt(sum_sq / std::max(count, 1));
+  };
+  const double filter_rmse = sliver_rmse(with(b, "none", beauty, normals));
+  const double mixed_rmse = sliver_rmse(with(b, "beauty", beauty, normals));
+  // With the normal of each pixel's centre the third surface does not show: the colours decide.
+  const double colours_rmse = sliver_rmse(with(b, "beauty", beauty, centre_normals));
+  std::printf(
+      "[ measure  ] wall pixels holding a sliver of a shelf's top face, against a supersampled "
+      "render: RMSE %.4f with the pixel filter, %.4f with the beauty's coverage and the Normal "
+      "pass, %.4f with the beauty's coverage and each pixel centre's normal\n",
+      filter_rmse, mixed_rmse, colours_rmse);
+  EXPECT_LT(mixed_rmse, 0.8 * colours_rmse);
+  EXPECT_LT(mixed_rmse, 1.1 * filter_rmse);
+
+  SlantedBoard slanted;
+  const std::vector<float> slanted_beauty = board_beauty(slanted, false);
+  const std::vector<float> slanted_normals = board_normals(slanted);
+  int edges = 0;
+  const double slanted_filter =
+      slanted.edge_rmse(with(slanted, "none", slanted_beauty, slanted_normals), edges);
+  const double slanted_mixed =
+      slanted.edge_rmse(with(slanted, "beauty", slanted_beauty, slanted_normals), edges);
+  std::printf(
+      "[ measure  ] slanted board edges (%d px), filtered Normal pass: RMSE %.4f with the pixel "
+      "filter, %.4f with the beauty's coverage\n",
+      edges, slanted_filter, slanted_mixed);
+  EXPECT_LT(slanted_mixed, 0.8 * slanted_filter);
 }
 
 // A renderer's Normal pass is filtered over each pixel like the beauty: on a crease it holds the
