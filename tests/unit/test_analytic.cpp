@@ -351,12 +351,14 @@ struct SlantedBoard {
   }
   // RMSE of `ao` over the edge pixels (2 px from the border) against the supersampled
   // ray-traced AO through the pixel filter; `count` gets how many there are.
-  double edge_rmse(const std::vector<float>& ao, int& count) {
+  double edge_rmse(const std::vector<float>& ao, int& count) { return rmse_over(ao, edge, count); }
+  // The same over the pixels `mask` marks.
+  double rmse_over(const std::vector<float>& ao, const std::vector<char>& mask, int& count) {
     double sum_sq = 0;
     count = 0;
     for (int y = 2; y + 2 < s.height; ++y) {
       for (int x = 2; x + 2 < s.width; ++x) {
-        if (!edge[index(x, y)]) continue;
+        if (!mask[index(x, y)]) continue;
         const double reference = filtered(x, y, [&](int i, int j) { return ao_at(i, j); });
         sum_sq += std::pow(ao[index(x, y)] - reference, 2);
         ++count;
@@ -409,6 +411,20 @@ TEST(Analytic, PixelFilterMixesBothSurfacesAtEdgesAsASupersampledRender) {
   EXPECT_LT(moved_inside, 0.05);
 }
 
+// Channel c of a 3-channel pass at sub-pixel point (i, j), value_at(i, j, c), through the
+// pixel filter into image's pixels 1 px from the border (the border keeps what image holds).
+template <class F>
+void filter_into(const SlantedBoard& b, F&& value_at, std::vector<float>& image) {
+  for (int y = 1; y + 1 < b.s.height; ++y) {
+    for (int x = 1; x + 1 < b.s.width; ++x) {
+      for (int c = 0; c < 3; ++c) {
+        image[b.index(x, y) * 3 + c] =
+            float(b.filtered(x, y, [&](int i, int j) { return value_at(i, j, c); }));
+      }
+    }
+  }
+}
+
 // The beauty a renderer would write of the board, red, before a blue wall: each surface's
 // colour filtered over the pixel like the AO pass. With `highlight`, the board's pixels on its
 // silhouette are white (a bevel catching the light, one pixel wide).
@@ -423,33 +439,22 @@ std::vector<float> board_beauty(const SlantedBoard& b, bool highlight) {
     return board ? kBoard[c] : kWall[c];
   };
   std::vector<float> beauty(s.depth.size() * 3, 0.0f);
-  for (int y = 1; y + 1 < s.height; ++y) {
-    for (int x = 1; x + 1 < s.width; ++x) {
-      for (int c = 0; c < 3; ++c) {
-        beauty[b.index(x, y) * 3 + c] =
-            float(b.filtered(x, y, [&](int i, int j) { return colour_at(i, j, c); }));
-      }
-    }
-  }
+  filter_into(b, colour_at, beauty);
   return beauty;
 }
 
 // The board's Normal pass as a renderer filters it, like the beauty: on an edge the average of
 // the normals the pixel's footprint sees (view space, 3 per pixel).
 std::vector<float> board_normals(const SlantedBoard& b) {
-  const Scene& s = b.s;
-  std::vector<float> normals = s.normal;
-  for (int y = 1; y + 1 < s.height; ++y) {
-    for (int x = 1; x + 1 < s.width; ++x) {
-      for (int c = 0; c < 3; ++c) {
-        normals[b.index(x, y) * 3 + c] = float(b.filtered(x, y, [&](int i, int j) {
-          V3 normal{0, 0, 0};
-          b.hit_at(i, j, normal);
-          return c == 0 ? normal.x : c == 1 ? normal.y : normal.z;
-        }));
-      }
-    }
-  }
+  std::vector<float> normals = b.s.normal;
+  filter_into(
+      b,
+      [&](int i, int j, int c) {
+        V3 normal{0, 0, 0};
+        b.hit_at(i, j, normal);
+        return c == 0 ? normal.x : c == 1 ? normal.y : normal.z;
+      },
+      normals);
   return normals;
 }
 
@@ -574,18 +579,10 @@ TEST(Analytic, BeautyCoverageLeavesPixelsThatHoldAThirdSurface) {
   };
   const std::vector<float> centre_normals = s.normal;
   const auto sliver_rmse = [&](const std::vector<float>& ao) {
-    double sum_sq = 0;
     int count = 0;
-    for (int y = 2; y + 2 < s.height; ++y) {
-      for (int x = 2; x + 2 < s.width; ++x) {
-        if (!sliver[b.index(x, y)]) continue;
-        const double reference = b.filtered(x, y, [&](int i, int j) { return b.ao_at(i, j); });
-        sum_sq += std::pow(ao[b.index(x, y)] - reference, 2);
-        ++count;
-      }
-    }
+    const double rmse = b.rmse_over(ao, sliver, count);
     EXPECT_GE(count, 12);
-    return std::sqrt(sum_sq / std::max(count, 1));
+    return rmse;
   };
   const double filter_rmse = sliver_rmse(with(b, "none", beauty, normals));
   const double mixed_rmse = sliver_rmse(with(b, "beauty", beauty, normals));
