@@ -116,7 +116,8 @@ void render_image(const Options& o, const RenderSetup& setup, const AnimationFra
   report_camera(o, scene, width, height, report);
 
   ScratchFolder scratch;
-  const PassRunner povray = make_pass_runner(povray_settings, setup, frame, scratch);
+  PassRunner povray = make_pass_runner(povray_settings, setup, frame, scratch);
+  povray.one_at_a_time = !scene.scan.file_write.empty();
   KeepFiles keep(scratch, o.keep, report);
   // The data passes libssao reads (depth, normals) see a band around the frame: occluders just
   // outside it darken its edges. The beauty and the ambient pass are the frame.
@@ -151,8 +152,9 @@ void render_image(const Options& o, const RenderSetup& setup, const AnimationFra
 
   const double ao_seconds = compute_and_write(o.params, output_files(o), in, report);
   const std::string written = o.output + (o.exr.empty() ? "" : " and " + o.exr);
-  report.progress("wrote %s in %.2f s (passes at once: %s; AO %.2f s)", written.c_str(),
-                  seconds_since(start), describe(passes.timings()).c_str(), ao_seconds);
+  report.progress("wrote %s in %.2f s (passes %s: %s; AO %.2f s)", written.c_str(),
+                  seconds_since(start), povray.one_at_a_time ? "one after another" : "at once",
+                  describe(passes.timings()).c_str(), ao_seconds);
 }
 
 // "1,5,7" (at most 50 numbers).

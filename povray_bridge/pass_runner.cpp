@@ -48,10 +48,16 @@ RunningPass PassRunner::start(const std::string& what, const std::string& name,
   pass.args = std::move(args);
   pass.process =
       std::make_unique<RunningProcess>(executable, pass.args, scene_folder, pass.log, pass.output);
+  if (one_at_a_time) finish(pass);
   return pass;
 }
 
 double PassRunner::finish(RunningPass& pass) const {
+  if (!pass.seconds) pass.seconds = wait_for(pass);
+  return *pass.seconds;
+}
+
+double PassRunner::wait_for(RunningPass& pass) const {
   double seconds = 0.0;
   RenderResult result;
   while (true) {

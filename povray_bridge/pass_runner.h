@@ -6,6 +6,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -22,7 +23,8 @@ struct RunningPass {
   std::vector<std::string> args;            // POV-Ray's command line, for a restart
   std::unique_ptr<RunningProcess> process;  // null: not started
   int attempts = 1;
-  uintmax_t log_start = 0;  // where this run's messages begin in the log
+  uintmax_t log_start = 0;        // where this run's messages begin in the log
+  std::optional<double> seconds;  // its wall-clock seconds, once finished
 };
 
 struct PassRunner {
@@ -36,18 +38,22 @@ struct PassRunner {
   const ScratchFolder* scratch = nullptr;
   bool keep = false;
   const AnimationFrame* frame = nullptr;  // an animation's frame: rendered alone (+SF +EF)
+  // Each run finishes before the next starts: for scenes that write files as they parse
+  // (SceneScan::file_write), which runs at once would read half-written from each other.
+  bool one_at_a_time = false;
 
   // Where POV-Ray writes +O<name>.exr: an animation frame's number goes before the extension.
   std::string output(const std::string& name) const;
 
-  // Starts rendering `wrapper` to output(name); finish() waits for it.
+  // Starts rendering `wrapper` to output(name); finish() waits for it. One at a time, it has
+  // finished when this returns.
   RunningPass start(const std::string& what, const std::string& name, const std::string& wrapper,
                     int width, int height, const std::vector<std::string>& extra) const;
 
-  // Waits for the run; returns its wall-clock seconds. Throws with POV-Ray's own messages when
-  // it failed or wrote no image; POV-Ray's parse error when it could not parse the scene.
-  // A run whose worker thread did not start in time (POV-Ray 3.7 gives it a few seconds, which
-  // a loaded machine can exceed) rendered nothing: it is started again, up to
+  // Waits for the run (if it has not finished); returns its wall-clock seconds. Throws with
+  // POV-Ray's own messages when it failed or wrote no image; POV-Ray's parse error when it could
+  // not parse the scene. A run whose worker thread did not start in time (POV-Ray 3.7 gives it a
+  // few seconds, which a loaded machine can exceed) rendered nothing: it is started again, up to
   // kStartupAttempts runs in all, each retry noted in the log.
   double finish(RunningPass& pass) const;
 
@@ -59,6 +65,10 @@ struct PassRunner {
   // start() and finish().
   double render(const std::string& what, const std::string& name, const std::string& wrapper,
                 int width, int height, const std::vector<std::string>& extra) const;
+
+ private:
+  // finish()'s wait, with the restarts.
+  double wait_for(RunningPass& pass) const;
 };
 
 // Copies the scratch folder's files to --keep DIR when it goes out of scope (also on failure).

@@ -79,6 +79,18 @@ void ImagePasses::start_normal_pass() {
 
 void ImagePasses::start() {
   ambient_pass_ = wants_ambient_pass();
+  const bool normals = !choices_.depth_only && scan_.includes_ssao_passes && !choices_.no_normals;
+  const char* passes = choices_.depth_only ? "the depth pass"
+                       : ambient_pass_ ? (normals ? "the beauty, depth, ambient and normal passes"
+                                                  : "the beauty, depth and ambient passes")
+                       : normals       ? "the beauty, depth and normal passes"
+                                       : "the beauty and the depth pass";
+  if (povray_.one_at_a_time) {
+    report_.progress(
+        "the scene writes a file as it parses (%s): rendering %s (%dx%d) one after another, "
+        "since side by side they would read it half-written from each other...",
+        scan_.file_write.c_str(), passes, width_, height_);
+  }
   if (!choices_.depth_only) {
     beauty_ = povray_.start("beauty", "beauty", "beauty.pov", width_, height_, {});
   }
@@ -87,12 +99,9 @@ void ImagePasses::start() {
     ambient_ = povray_.start("ambient pass", "ambient", "ambient.pov", width_, height_,
                              {scan_.uses_quick_color ? "+Q6" : "+Q3", "-A", "-UA"});
   }
-  if (!choices_.depth_only && scan_.includes_ssao_passes && !choices_.no_normals) {
-    start_normal_pass();
-  }
+  if (normals) start_normal_pass();
   depth_.choose_fogs();
   depth_.start();
-  const bool normals = normals_.process != nullptr;
   const int data_width = width_ + 2 * band_, data_height = height_ + 2 * band_;
   if (band_ > 0) {
     report_.progress(
@@ -100,13 +109,8 @@ void ImagePasses::start() {
         normals ? " and normal" : "", normals ? "es are" : " is", data_width, data_height, width_,
         height_);
   }
-  report_.progress("rendering %s (%dx%d) at once...",
-                   choices_.depth_only ? "the depth pass"
-                   : ambient_pass_     ? (normals ? "the beauty, depth, ambient and normal passes"
-                                                  : "the beauty, depth and ambient passes")
-                   : normals           ? "the beauty, depth and normal passes"
-                                       : "the beauty and the depth pass",
-                   width_, height_);
+  if (!povray_.one_at_a_time)
+    report_.progress("rendering %s (%dx%d) at once...", passes, width_, height_);
   // The image file module (OpenImageIO) loads while POV-Ray renders.
   ssao_tools::preload_image_io();
 }

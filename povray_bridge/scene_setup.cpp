@@ -244,8 +244,10 @@ ImageScene read_image_scene(const CameraOverrides& camera_flags, bool print_came
   }
   if (scene.reading.default_camera && !camera_flags.any() && !print_camera) {
     ScratchFolder scratch;
-    check_default_camera(make_pass_runner(povray, setup, frame, scratch), setup.scene_name,
-                         scene.scan, scene.reading.camera, setup.width, setup.height, report);
+    PassRunner runner = make_pass_runner(povray, setup, frame, scratch);
+    runner.one_at_a_time = !scene.scan.file_write.empty();
+    check_default_camera(runner, setup.scene_name, scene.scan, scene.reading.camera, setup.width,
+                         setup.height, report);
   }
   return scene;
 }

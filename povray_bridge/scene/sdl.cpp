@@ -872,7 +872,7 @@ class Scanner {
 
  private:
   void scan_tokens(const std::vector<Token>& tokens, int depth) {
-    find_camera_macros(tokens);
+    find_macros(tokens);
     size_t i = 0;
     while (tokens[i].kind != Token::kEnd) {
       const Token& token = tokens[i];
@@ -889,6 +889,7 @@ class Scanner {
         ++i;
         continue;
       }
+      note_file_writes(tokens, i, i + 1);
       if (token.kind == Token::kIdent) {
         const size_t next = global_setting(tokens, i);
         if (next != i) {
@@ -918,16 +919,13 @@ class Scanner {
         i = end;
         continue;
       }
-      const auto made_by = token.kind == Token::kIdent && is_punct(tokens[i + 1], "(")
-                               ? camera_macros_.find(token.text)
-                               : camera_macros_.end();
-      if (made_by != camera_macros_.end()) {
+      if (const std::string made_at = call_holds(tokens, i, &Macro::camera_at); !made_at.empty()) {
         // A call of a macro that makes a camera: not expanded, but never passed over (the
         // camera POV-Ray uses would silently be another).
         CameraSource camera;
         camera.kind = CameraSource::kMacroCall;
-        camera.macro = made_by->first;
-        camera.macro_camera_at = made_by->second;
+        camera.macro = token.text;
+        camera.macro_camera_at = made_at;
         camera.location = where(token);
         camera.conditional = conditionals_.unknown_depth() > 0;
         result.cameras.push_back(std::move(camera));
@@ -938,49 +936,92 @@ class Scanner {
     }
   }
 
-  // The macros of `tokens` that make a camera: a camera { } block in their body, or a call of
-  // such a macro (screen.inc's Set_Camera calls Update_Camera), with where that block is.
-  // (SSAOCamera, ssao_passes.inc's, is read from its arguments instead.)
-  void find_camera_macros(const std::vector<Token>& tokens) {
-    struct Body {
-      std::string name;
-      size_t begin, end;
-    };
-    std::vector<Body> bodies;
+  // What the scan knows of a macro's body (which it does not run).
+  struct Macro {
+    std::string camera_at;           // where a camera { } block in it is, or ""
+    std::string fopen_at;            // where an #fopen ... write/append in it is, or ""
+    std::vector<std::string> calls;  // the NAME( it holds: the macros it may call
+  };
+
+  // Records the macros `tokens` declares. A later declaration replaces an earlier one, as in
+  // POV-Ray. (SSAOCamera, ssao_passes.inc's, is read from its arguments instead.)
+  void find_macros(const std::vector<Token>& tokens) {
     for (size_t i = 0; tokens[i].kind != Token::kEnd; ++i) {
       if (tokens[i].kind != Token::kDirective || tokens[i].text != "macro" ||
           tokens[i + 1].kind != Token::kIdent || !is_punct(tokens[i + 2], "(")) {
         continue;
       }
-      const size_t begin = skip_group(tokens, i + 2);
-      size_t end = begin;
-      for (int open = 1; tokens[end].kind != Token::kEnd; ++end) {
-        const Token& t = tokens[end];
-        if (t.kind != Token::kDirective) continue;
-        if (opens_block(t.text)) {
-          ++open;
-        } else if (t.text == "end" && --open == 0) {
-          break;
+      Macro macro;
+      int open = 1;
+      for (size_t k = skip_group(tokens, i + 2); tokens[k].kind != Token::kEnd; ++k) {
+        const Token& t = tokens[k];
+        if (t.kind == Token::kDirective && opens_block(t.text)) ++open;
+        if (t.kind == Token::kDirective && t.text == "end" && --open == 0) break;
+        if (t.kind == Token::kIdent && t.text == "camera" && is_punct(tokens[k + 1], "{")) {
+          if (macro.camera_at.empty()) macro.camera_at = where(t);
+        } else if (t.kind == Token::kIdent && is_punct(tokens[k + 1], "(")) {
+          macro.calls.push_back(t.text);
+        } else if (opens_file_for_writing(tokens, k) && macro.fopen_at.empty()) {
+          macro.fopen_at = where(t);
         }
       }
-      if (tokens[i + 1].text != "SSAOCamera") bodies.push_back({tokens[i + 1].text, begin, end});
+      if (tokens[i + 1].text != "SSAOCamera") macros_[tokens[i + 1].text] = std::move(macro);
+      holds_.clear();
     }
-    for (bool changed = true; changed;) {
-      changed = false;
-      for (const Body& body : bodies) {
-        if (camera_macros_.count(body.name)) continue;
-        for (size_t k = body.begin; k < body.end; ++k) {
-          const Token& t = tokens[k];
-          if (t.kind != Token::kIdent || !is_punct(tokens[k + 1], t.text == "camera" ? "{" : "(")) {
-            continue;
-          }
-          const auto called = camera_macros_.find(t.text);
-          if (t.text == "camera" || called != camera_macros_.end()) {
-            camera_macros_[body.name] = t.text == "camera" ? where(t) : called->second;
-            changed = true;
-            break;
-          }
-        }
+  }
+
+  // Where the macro `name` makes a camera (found = &Macro::camera_at) or writes a file
+  // (&Macro::fopen_at), itself or through the macros it calls (screen.inc's Set_Camera calls
+  // Update_Camera); "" if it does not, or is not a macro the scan has read.
+  std::string macro_holds(const std::string& name, std::string Macro::*found) {
+    // Remembered until a macro is declared: a scene calls the same macros many times.
+    const std::string key = name + (found == &Macro::camera_at ? " camera" : " fopen");
+    if (const auto known = holds_.find(key); known != holds_.end()) return known->second;
+    return holds_[key] = search_calls(name, found);
+  }
+
+  // macro_holds()'s search through the calls, each macro once (macros may recurse).
+  std::string search_calls(const std::string& name, std::string Macro::*found) const {
+    std::set<std::string> seen;
+    std::vector<std::string> pending = {name};
+    while (!pending.empty()) {
+      const std::string next = std::move(pending.back());
+      pending.pop_back();
+      const auto macro = macros_.find(next);
+      if (macro == macros_.end() || !seen.insert(next).second) continue;
+      if (!(macro->second.*found).empty()) return macro->second.*found;
+      pending.insert(pending.end(), macro->second.calls.begin(), macro->second.calls.end());
+    }
+    return "";
+  }
+
+  // macro_holds() for a call NAME( at tokens[k]; "" for any other token.
+  std::string call_holds(const std::vector<Token>& tokens, size_t k, std::string Macro::*found) {
+    if (tokens[k].kind != Token::kIdent || !is_punct(tokens[k + 1], "(")) return "";
+    return macro_holds(tokens[k].text, found);
+  }
+
+  // #fopen NAME "file" write|append at tokens[k] (the file name may be an expression).
+  static bool opens_file_for_writing(const std::vector<Token>& tokens, size_t k) {
+    if (tokens[k].kind != Token::kDirective || tokens[k].text != "fopen") return false;
+    for (size_t j = k + 1; tokens[j].kind != Token::kEnd && tokens[j].kind != Token::kDirective;
+         ++j) {
+      if (tokens[j].kind != Token::kIdent) continue;
+      if (tokens[j].text == "write" || tokens[j].text == "append") return true;
+      if (tokens[j].text == "read") return false;
+    }
+    return false;
+  }
+
+  // Notes the first place where parsing the scene writes a file: an #fopen for writing, or a
+  // call of a macro that makes one, among tokens[begin, end).
+  void note_file_writes(const std::vector<Token>& tokens, size_t begin, size_t end) {
+    for (size_t k = begin; k < end && result.file_write.empty(); ++k) {
+      if (opens_file_for_writing(tokens, k)) {
+        result.file_write = where(tokens[k]) + ": #fopen for writing";
+      } else if (const std::string at = call_holds(tokens, k, &Macro::fopen_at); !at.empty()) {
+        result.file_write = where(tokens[k]) + " calls " + tokens[k].text +
+                            "(), which opens a file for writing at " + at;
       }
     }
   }
@@ -1035,7 +1076,12 @@ class Scanner {
   // index of the next token to look at.
   size_t directive(const std::vector<Token>& tokens, size_t i, int depth) {
     const std::string& name = tokens[i].text;
-    if (name == "declare" || name == "local") return declaration(tokens, i + 1);
+    if (name == "declare" || name == "local") {
+      const size_t next = declaration(tokens, i + 1);
+      note_file_writes(tokens, i, next);  // #declare M = MakeMesh(...)
+      return next;
+    }
+    if (name == "fopen") note_file_writes(tokens, i, i + 1);
     if (name == "undef" && tokens[i + 1].kind == Token::kIdent) {
       symbols_.erase(tokens[i + 1].text);
       return i + 2;
@@ -1205,7 +1251,8 @@ class Scanner {
   int includes_read_ = 0;
   size_t settings_end_ = 0;  // index after the global_settings block being read (this file)
   Symbols symbols_;
-  std::map<std::string, std::string> camera_macros_;  // macro -> where its camera block is
+  std::map<std::string, Macro> macros_;       // the macros read so far, by name
+  std::map<std::string, std::string> holds_;  // macro_holds(), by "NAME camera|fopen"
   EvalContext context_;
   Conditionals conditionals_;
 };

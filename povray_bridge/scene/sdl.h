@@ -162,6 +162,9 @@ struct SceneScan {
   std::string ambient_light_problem;    // why the last ambient_light could not be read, or ""
   bool uses_radiosity = false;          // a radiosity { } block in global_settings
   bool uses_quick_color = false;        // quick_color/quick_colour appears (used below +Q6)
+  // Where parsing the scene writes a file, or "": an #fopen ... write/append, or a call of a
+  // macro that makes one (strings.inc's Parse_String). Passes rendered at once would share it.
+  std::string file_write;
 };
 
 struct ScanSettings {
@@ -177,7 +180,8 @@ struct ScanSettings {
 // in the library paths, with ".inc" appended if needed (includes that cannot be found are
 // skipped). #if/#ifdef/#ifndef/#elseif/#else/#switch/#case/#range conditions that can be
 // evaluated select their branch as POV-Ray would; the others, and loops, are read entirely
-// (cameras found there are marked conditional). Macro bodies are not read. Throws
+// (cameras found there are marked conditional). Macro bodies are not read, but the macros
+// that make a camera or write a file are known where they are called. Throws
 // ssao_tools::Error if `path` cannot be read or tokenized.
 SceneScan scan_scene(const std::string& path, const ScanSettings& settings);
 

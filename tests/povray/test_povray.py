@@ -1461,6 +1461,33 @@ Parse_String("camera { location <2, 3, -3> look_at <0, 0, 5> angle 50 }")
         self.assert_ok(proc, out)
 
 
+class FileWritingSceneTest(PovTestCase):
+    """A scene that writes a file as it parses (strings.inc's Parse_String writes
+    parse_string.tmp in the scene's folder and includes it): its passes run one after another.
+    At once, they would read it half-written from each other: measured on four POV-Rays started
+    together on a scene calling Parse_String 300 times, 15 of 20 runs failed to parse and one
+    never ended."""
+
+    def test_passes_run_one_after_another(self):
+        camera = "camera { location <2, 3, -3> look_at <0, 0, 5> angle 50 }\n"
+        box = "box { <-2.2, -1, 4>, <-1.2, 0.3, 5> pigment { rgb 0.7 } }"
+        written = self.copy_scene("written.pov", NO_CAMERA_SCENE + camera + box + "\n")
+        parsed = self.copy_scene("parsed.pov", NO_CAMERA_SCENE + camera +
+                                 '#include "strings.inc"\nParse_String("' + box + '")\n')
+        proc, names, pixels, _ = self.bridge_exr(parsed, "--radius", "0.5", name="parsed")
+        call_line = len(NO_CAMERA_SCENE.splitlines()) + 3
+        self.assertIn(f"parsed.pov:{call_line} calls Parse_String(), which opens a file for "
+                      "writing at strings.inc:", proc.stdout, self.detail(proc))
+        self.assertIn("one after another", proc.stdout, self.detail(proc))
+        self.assertNotIn("at once", proc.stdout, self.detail(proc))
+        # The same image as the scene with the box written out (rendered at once).
+        proc, written_names, written_pixels, _ = self.bridge_exr(written, "--radius", "0.5",
+                                                                 name="written")
+        self.assertIn("at once", proc.stdout, self.detail(proc))
+        self.assertEqual(names, written_names)
+        np.testing.assert_array_equal(pixels, written_pixels)
+
+
 # Focal blur: in focus at the sphere (6.1 from the camera), the floor in front and the box far
 # behind out of focus.
 FOCAL_BLUR_SCENE = """#version 3.7;

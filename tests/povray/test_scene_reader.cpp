@@ -355,6 +355,55 @@ TEST_F(SceneFile, RefusalsNameTheConstruct) {
   }
 }
 
+TEST_F(SceneFile, FileWritesAreFoundWherePovRayParsesThem) {
+  // Passes rendered at once would share such a file (povray-ssao renders them one after
+  // another): an #fopen for writing, or a call of a macro that opens one, itself or through
+  // another, in whatever order their files are read.
+  write("strings2.inc",
+        "#macro Parse(S) #fopen F \"tmp.inc\" write #write(F, S) #fclose F "
+        "#include \"tmp.inc\" #end");
+  write("reader.inc", "#macro Load() #fopen F \"data.txt\" read #read(F, N) #fclose F #end");
+  struct Case {
+    const char* text;
+    const char* found;  // where file_write points, or "" for none
+  };
+  const std::vector<Case> cases = {
+      {"#fopen Log \"log.txt\" write", "scene.pov:1: #fopen"},
+      {"#fopen Log concat(\"log\", str(clock, 0, 0)) append", "scene.pov:1: #fopen"},
+      {"#fopen In \"in.txt\" read", ""},
+      {"#include \"reader.inc\"\nLoad()", ""},
+      {"#include \"strings2.inc\"\n", ""},  // declared, never called
+      {"#include \"strings2.inc\"\nParse(\"#declare A = 1;\")",
+       "scene.pov:2 calls Parse(), which opens a file for writing at strings2.inc:1"},
+      // The caller is declared before the include that declares what it calls.
+      {"#macro Cam() Parse(\"camera { }\") #end\n#include \"strings2.inc\"\nCam()",
+       "scene.pov:3 calls Cam(), which opens a file for writing at strings2.inc:1"},
+      {"#include \"strings2.inc\"\n#declare M = Parse(\"sphere { 0, 1 }\");",
+       "scene.pov:2 calls Parse()"},
+      {"#include \"strings2.inc\"\n#if (0) Parse(\"\") #end", ""},
+      {"#if (0) #fopen Log \"log.txt\" write #end", ""},
+      {"#macro Log() #fopen L \"log.txt\" write #end", ""},
+  };
+  for (const Case& c : cases) {
+    const std::string found = scan(c.text).file_write;
+    if (*c.found == '\0') {
+      EXPECT_EQ(found, "") << c.text;
+    } else {
+      EXPECT_EQ(found.rfind(c.found, 0), 0u) << c.text << ": " << found;
+    }
+  }
+  // The same lookup finds a camera macro through an include read after its caller.
+  write("cams.inc", "#macro In() camera { location -z look_at 0 } #end");
+  try {
+    camera("#macro Out() In() #end\n#include \"cams.inc\"\nOut()");
+    ADD_FAILURE() << "a camera made by a macro was read";
+  } catch (const ssao_tools::Error& e) {
+    EXPECT_NE(std::string(e.what()).find("macro 'Out' (its camera { } block at cams.inc:1)"),
+              std::string::npos)
+        << e.what();
+  }
+}
+
 TEST_F(SceneFile, IncludesAreFollowedAsPovRayFindsThem) {
   write("shot.inc", "#declare Shot = camera { location <0, 0, -7> look_at 0 angle 40 }");
   const CameraReading reading = camera("#include \"shot\" camera { Shot }");  // .inc appended
