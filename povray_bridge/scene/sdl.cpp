@@ -1191,8 +1191,11 @@ class Scanner {
       size_t end = is_punct(tokens[j], "{") ? skip_group(tokens, j) : j;
       if (first.text == "camera" || first.text == "transform") {
         symbol.kind = first.text == "camera" ? Symbol::kCamera : Symbol::kTransform;
+        // Never a range that ends before it starts: an unclosed "{" last in the file has no
+        // closing brace to drop (found by fuzz_pov_scene: "#declare C = camera {").
+        const size_t last = std::max(j + 1, end - 1);
         symbol.tokens.assign(tokens.begin() + static_cast<long>(j) + 1,
-                             tokens.begin() + static_cast<long>(end) - 1);
+                             tokens.begin() + static_cast<long>(last));
       } else {
         symbol.kind = Symbol::kOther;
         symbol.description = "a " + first.text;
