@@ -122,6 +122,63 @@ SSAO_VECTORIZE void jump_row(const float* __restrict depth, const float* __restr
   }
 }
 
+// Where point m lies along the line from b to a: `share` such that b + share (a - b) is its
+// nearest point. True if m lies within tolerance x |a - b| of that line (false for a == b, NaN).
+bool share_on_line(const Vec3& m, const Vec3& a, const Vec3& b, float tolerance, float& share) {
+  const Vec3 ab = a - b;
+  const float length_squared = dot(ab, ab);
+  if (!(length_squared > 0.0f)) return false;
+  share = dot(m - b, ab) / length_squared;
+  const Vec3 off = m - b - ab * share;
+  return dot(off, off) <= tolerance * tolerance * length_squared;
+}
+
+// Pixel p's share of its own surface read from the beauty's colours (see mix_edges_by_beauty):
+// own, other: the colours beyond p and beyond n; mixed, neighbour: p's and n's.
+bool own_share_from_colours(const Vec3& own, const Vec3& other, const Vec3& mixed,
+                            const Vec3& neighbour, float& share) {
+  const Vec3 difference = own - other;
+  const float contrast = dot(difference, difference);
+  const float larger = std::max(dot(own, own), dot(other, other));
+  if (!(contrast > 0.0f) || contrast < kEdgeColourContrast * kEdgeColourContrast * larger) {
+    return false;
+  }
+  // p and n are mixes of the two surfaces (n mostly B's), so their colours lie on the line
+  // from B to A, and n's between them. Where one lies well off (a highlight on a board's
+  // front edge, another face of the same object beyond n), A and B are not the colours of
+  // p's and n's surfaces: no mix.
+  float neighbour_share = 0.0f;
+  return share_on_line(neighbour, own, other, kEdgeColourTolerance, neighbour_share) &&
+         share_on_line(mixed, own, other, kEdgeColourTolerance, share) &&
+         neighbour_share >= -kEdgeColourTolerance && neighbour_share <= 1.0f + kEdgeColourTolerance;
+}
+
+// The same from the Normal pass, filtered over the pixel like the beauty: own and other are the
+// normals beyond p and beyond n, own_next and other_next those one pixel further out, mixed and
+// neighbour p's and n's. The two surfaces' normals must differ by kEdgeNormalContrast or more
+// and each be steady (its next pixel out within kEdgeNormalSteady of it: a face, not a crease or
+// a curve that p's own normal would not follow), and p's and n's normals lie on the line
+// between them as the colours must. A pass filtered over the pixel shows a mix in p or in n
+// (the filter straddles the edge); one that holds each pixel centre's normal (POV-Ray's, without
+// anti-aliasing) shows none, and says nothing of coverage.
+bool own_share_from_normals(const Vec3& own, const Vec3& own_next, const Vec3& other,
+                            const Vec3& other_next, const Vec3& mixed, const Vec3& neighbour,
+                            float& share) {
+  const Vec3 difference = own - other, own_step = own_next - own, other_step = other_next - other;
+  if (!(dot(difference, difference) >= kEdgeNormalContrast * kEdgeNormalContrast) ||
+      !(dot(own_step, own_step) <= kEdgeNormalSteady * kEdgeNormalSteady) ||
+      !(dot(other_step, other_step) <= kEdgeNormalSteady * kEdgeNormalSteady)) {
+    return false;
+  }
+  float neighbour_share = 0.0f;
+  return share_on_line(neighbour, own, other, kEdgeColourTolerance, neighbour_share) &&
+         share_on_line(mixed, own, other, kEdgeColourTolerance, share) &&
+         neighbour_share >= -kEdgeColourTolerance &&
+         neighbour_share <= 1.0f + kEdgeColourTolerance && share >= -kEdgeColourTolerance &&
+         share <= 1.0f + kEdgeColourTolerance &&
+         (share < 1.0f - kEdgeNormalMixShown || neighbour_share > kEdgeNormalMixShown);
+}
+
 // Whether normal m (of a pixel of the Normal pass, filtered over it like the beauty) is a mix of
 // normals a and b: within kEdgeNormalTolerance of the segment between them. NaN: no.
 bool normal_is_mix(const Vec3& m, const Vec3& a, const Vec3& b) {
@@ -194,41 +251,35 @@ void mix_edges_by_beauty(const Frame& frame, const ImageView& beauty, const Imag
           depth_jump(frame.depth(nx, ny), frame.depth(nx + sx, ny + sy))) {
         continue;
       }
-      Vec3 own, other, mixed;
-      if (!beauty_colour(beauty, x - sx - dx, y - sy - dy, own) ||
-          !beauty_colour(beauty, nx + sx - dx, ny + sy - dy, other) ||
-          !beauty_colour(beauty, x - dx, y - dy, mixed)) {
-        continue;
+      Vec3 own, other, mixed, neighbour;
+      float colour_share = 0.0f, normal_share = 0.0f;
+      const bool by_colours = beauty_colour(beauty, x - sx - dx, y - sy - dy, own) &&
+                              beauty_colour(beauty, nx + sx - dx, ny + sy - dy, other) &&
+                              beauty_colour(beauty, x - dx, y - dy, mixed) &&
+                              beauty_colour(beauty, nx - dx, ny - dy, neighbour) &&
+                              own_share_from_colours(own, other, mixed, neighbour, colour_share);
+      bool by_normals = false;
+      if (normal.attached()) {
+        const Vec3 own_normal = normal_at(x - sx, y - sy),
+                   other_normal = normal_at(nx + sx, ny + sy);
+        const Vec3 mixed_normal = normal_at(x, y);
+        if (!normal_is_mix(mixed_normal, own_normal, other_normal)) continue;
+        const int ox = x - 2 * sx, oy = y - 2 * sy, fx = nx + 2 * sx, fy = ny + 2 * sy;
+        by_normals =
+            ox >= 0 && oy >= 0 && ox < frame.width() && oy < frame.height() && fx >= 0 && fy >= 0 &&
+            fx < frame.width() && fy < frame.height() &&
+            own_share_from_normals(own_normal, normal_at(ox, oy), other_normal, normal_at(fx, fy),
+                                   mixed_normal, normal_at(nx, ny), normal_share);
       }
-      const Vec3 difference = own - other;
-      const float contrast = dot(difference, difference);
-      const float larger = std::max(dot(own, own), dot(other, other));
-      if (!(contrast > 0.0f) || contrast < kEdgeColourContrast * kEdgeColourContrast * larger) {
-        continue;
-      }
-      // p and n are mixes of the two surfaces (n mostly B's), so their colours lie on the line
-      // from B to A, and n's between them. Where one lies well off (a highlight on a board's
-      // front edge, another face of the same object beyond n), A and B are not the colours of
-      // p's and n's surfaces: no mix.
-      const float tolerance = kEdgeColourTolerance * kEdgeColourTolerance * contrast;
-      const auto share_on_line = [&](const Vec3& colour, float& share) {
-        share = dot(colour - other, difference) / contrast;
-        const Vec3 off = colour - other - difference * share;
-        return dot(off, off) <= tolerance;
-      };
-      Vec3 neighbour;
-      float beta = 0.0f, neighbour_share = 0.0f;
-      if (!beauty_colour(beauty, nx - dx, ny - dy, neighbour) ||
-          !share_on_line(neighbour, neighbour_share) || !share_on_line(mixed, beta) ||
-          !(neighbour_share >= -kEdgeColourTolerance &&
-            neighbour_share <= 1.0f + kEdgeColourTolerance)) {
-        continue;
-      }
-      if (normal.attached() &&
-          !normal_is_mix(normal_at(x, y), normal_at(x - sx, y - sy), normal_at(nx + sx, ny + sy))) {
-        continue;
-      }
-      beta = std::min(1.0f, std::max(0.0f, beta));
+      if (!by_colours && !by_normals) continue;
+      // Where both read a mix, as little of one as either reads (a shadow's gradient makes the
+      // colours read more of the other surface, a crease in it the normals). The Depth pass's
+      // sample at p's centre is on p's surface: for a straight edge through a symmetric pixel
+      // filter that side holds at least half of the pixel.
+      float beta = by_colours && by_normals ? std::max(colour_share, normal_share)
+                   : by_colours             ? colour_share
+                                            : normal_share;
+      beta = std::min(1.0f, std::max(kEdgeMinOwnShare, beta));
       // Each surface's AO through the pixel filter, over the pixels around p on that surface
       // (without the filter, p's and n's own).
       const float side = weight, centre = 1.0f - 2.0f * weight;

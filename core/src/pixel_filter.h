@@ -30,22 +30,29 @@ Tile pixel_filter_source(const Frame& frame, const Tile& t);
 // Parameter edge_coverage = beauty (measured in docs/variants.md). At a depth edge the Depth pass
 // holds the surface at the pixel's centre, but a renderer's anti-aliased beauty is the
 // coverage-weighted mix of both surfaces' colours, and so is its AO pass. Where pixel p of tile t
-// has a depth jump (more than kEdgeDepthJump relative) to a 4-neighbour n, and the pixel beyond p
-// on its own surface and the one beyond n on n's show colours A and B that differ enough to read a
-// mix (|A - B| at least kEdgeColourContrast x the larger of |A|, |B|), and the colours C of p and
-// N of n lie on the line through B and A, N between them (each within kEdgeColourTolerance x
-// |A - B| of it; else A and B are not the colours of p's and n's surfaces, e.g. a highlight on
-// n), p's share of its own surface is beta = (C - B) . (A - B) / |A - B|^2 (clamped to [0, 1])
-// and out(p) = beta AO_p + (1 - beta) AO_n, where AO_p and AO_n are the pixel filter (weight w)
-// over the pixels around p on p's and on n's surface alone, from `source` (tile `around`, as for
-// pixel_filter). Where the Normal pass is given (`normal`, the depth image's size: frame pixel
-// (x, y) is its pixel (x, y); unattached: no such test), p's normal must also be a mix of the
-// normals beyond p and beyond n (within kEdgeNormalTolerance of the segment between them): else p
-// holds a third surface too small to show elsewhere (the top of a board seen at a grazing angle,
-// a sliver in a pixel), whose colour the two-colour model would read as one of the two.
-// Elsewhere out is left as it is. `beauty` has the output window's size: frame pixel (x, y) is
-// its pixel (x - dx, y - dy); its first three channels are read (one channel: grey). A jump to
-// the sky does not count (the normal pass's coverage handles it).
+// has a depth jump (more than kEdgeDepthJump relative) to a 4-neighbour n, p's share beta of its
+// own surface is read from the colours and from the normals:
+// - colours: the pixel beyond p on its own surface and the one beyond n on n's show colours A and
+//   B that differ enough to read a mix (|A - B| at least kEdgeColourContrast x the larger of |A|,
+//   |B|), and the colours C of p and N of n lie on the line through B and A, N between them (each
+//   within kEdgeColourTolerance x |A - B| of it; else A and B are not the colours of p's and n's
+//   surfaces, e.g. a highlight on n): beta = (C - B) . (A - B) / |A - B|^2;
+// - normals, where the Normal pass is given (`normal`, the depth image's size: frame pixel (x, y)
+//   is its pixel (x, y)) and filtered over the pixel like the beauty: the same with the normals,
+//   where the two surfaces' differ by kEdgeNormalContrast or more, each is steady one pixel
+//   further out (within kEdgeNormalSteady) and p or n shows a mix (by more than
+//   kEdgeNormalMixShown; a pass of pixel-centre normals shows none).
+// Where both read a mix beta is the larger (the smaller share of the other surface), and never
+// under kEdgeMinOwnShare (p's centre is on its own surface); out(p) = beta AO_p + (1 - beta) AO_n,
+// where AO_p and AO_n are the pixel filter (weight w) over the pixels around p on p's and on n's
+// surface alone, from `source` (tile `around`, as for pixel_filter). Where the Normal pass is
+// given, p's normal must also be a mix of the normals beyond p and beyond n (within
+// kEdgeNormalTolerance of the segment between them): else p holds a third surface too small to
+// show elsewhere (the top of a board seen at a grazing angle, a sliver in a pixel), whose colour
+// the two-colour model would read as one of the two. Elsewhere out is left as it is. `beauty`
+// has the output window's size: frame pixel (x, y) is its pixel (x - dx, y - dy); its first
+// three channels are read (one channel: grey). A jump to the sky does not count (the normal
+// pass's coverage handles it).
 void mix_edges_by_beauty(const Frame& frame, const ImageView& beauty, const ImageView& normal,
                          int dx, int dy, const Tile& around, const float* source, const Tile& t,
                          float weight, float* out);
@@ -53,5 +60,9 @@ constexpr float kEdgeDepthJump = 0.05f;
 constexpr float kEdgeColourContrast = 0.5f;
 constexpr float kEdgeColourTolerance = 0.25f;
 constexpr float kEdgeNormalTolerance = 0.3f;
+constexpr float kEdgeNormalContrast = 0.15f;
+constexpr float kEdgeNormalSteady = 0.05f;
+constexpr float kEdgeNormalMixShown = 0.02f;
+constexpr float kEdgeMinOwnShare = 0.5f;
 
 }  // namespace ssao

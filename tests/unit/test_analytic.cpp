@@ -290,17 +290,22 @@ TEST(Analytic, PerspectiveAndOrthographicAgree) {
 // Depth pass holds one of them; the reference does too: ray-traced AO at 3 x 3 points a pixel,
 // weighted by a Gaussian pixel filter of standard deviation 0.5 px (truncated at 1.5 px).
 // `below`: how far the board's centre lies below the view axis; `wall`: the wall's depth;
-// `half_height`: half the board's height; `degrees`: its turn about the view axis.
+// `half_height`: half the board's height; `degrees`: its turn about the view axis; `tilt`: its
+// turn about its own long axis, in degrees (its front face then no longer faces the wall's way).
 struct SlantedBoard {
   explicit SlantedBoard(double below = 0.0, double wall = 5.6, double half_height = 0.6,
-                        double degrees = 20.0) {
-    const double turn = degrees * M_PI / 180.0;
-    const V3 across{std::cos(turn), std::sin(turn), 0}, up{-std::sin(turn), std::cos(turn), 0};
-    const V3 towards{0, 0, 1}, centre{0, -below, -5.15};  // front face at depth 5
+                        double degrees = 20.0, double tilt = 0.0) {
+    const double turn = degrees * M_PI / 180.0, lean = tilt * M_PI / 180.0;
+    const V3 across{std::cos(turn), std::sin(turn), 0};
+    const V3 up =
+        V3{-std::sin(turn), std::cos(turn), 0} * std::cos(lean) + V3{0, 0, std::sin(lean)};
+    const V3 towards =
+        V3{0, 0, 1} * std::cos(lean) - V3{-std::sin(turn), std::cos(turn), 0} * std::sin(lean);
+    const V3 centre{0, -below, -5.15};  // front face at depth 5 (untilted)
     board = {{centre + across * 1.2, across},    {centre - across * 1.2, across * -1.0},
              {centre + up * half_height, up},    {centre - up * half_height, up * -1.0},
              {centre + towards * 0.15, towards}, {centre - towards * 0.15, towards * -1.0}};
-    solids = {board, {{{0, 0, -wall}, towards}}};
+    solids = {board, {{{0, 0, -wall}, {0, 0, 1}}}};
     behind = 0.5 * (5.3 + wall);
     s = ray_cast(cam, solids);
     // Pixels with a depth jump of more than 5 % to a 4-neighbour (both surfaces geometry).
@@ -609,6 +614,60 @@ TEST(Analytic, BeautyCoverageLeavesPixelsThatHoldAThirdSurface) {
       "filter, %.4f with the beauty's coverage\n",
       edges, slanted_filter, slanted_mixed);
   EXPECT_LT(slanted_mixed, 0.8 * slanted_filter);
+}
+
+// Where the two surfaces' colours are alike (one material) the Normal pass, filtered over the
+// pixel like the beauty, says how much of the pixel each covers if their normals differ: the
+// slanted board tilted 20 degrees about its long axis, one grey everywhere. Tilted, it shows its
+// top face along its upper silhouette, a third surface there: the test is over the edge pixels
+// whose filter sees the front face and the wall alone.
+TEST(Analytic, NormalPassCoverageMixesEdgesWhoseColoursAreAlike) {
+  SlantedBoard b(0.0, 5.6, 0.6, 20.0, 20.0);
+  Scene& s = b.s;
+  std::vector<float> grey(s.depth.size() * 3, 0.5f);
+  const std::vector<float> normals = board_normals(b), centre_normals = s.normal;
+  std::vector<char> two_surfaces(s.depth.size(), 0);
+  const V3 front = b.board[4].normal, wall{0, 0, 1};
+  for (int y = 1; y + 1 < s.height; ++y) {
+    for (int x = 1; x + 1 < s.width; ++x) {
+      bool only_two = b.edge[b.index(x, y)];
+      for (int j = (y - 1) * b.kSub; only_two && j < (y + 2) * b.kSub; ++j) {
+        for (int i = (x - 1) * b.kSub; only_two && i < (x + 2) * b.kSub; ++i) {
+          V3 normal{0, 0, 0};
+          b.hit_at(i, j, normal);
+          only_two = dot(normal, front) > 0.999 || dot(normal, wall) > 0.999;
+        }
+      }
+      two_surfaces[b.index(x, y)] = only_two;
+    }
+  }
+  const auto with = [&](const char* coverage, const std::vector<float>& normal) {
+    s.normal = normal;
+    return compute_ao(s, b.cam, b.radius, "hemisphere", true, [&](Job& j) {
+      j.set("resolution", "full");
+      j.set("edge_coverage", coverage);
+      j.image("beauty", grey, s.width, s.height, 3);
+    });
+  };
+  const auto filtered = with("none", normals);
+  const auto mixed = with("beauty", normals);
+  int count = 0, edges = 0;
+  const double filtered_rmse = b.rmse_over(filtered, two_surfaces, count);
+  const double mixed_rmse = b.rmse_over(mixed, two_surfaces, count);
+  const double filtered_all = b.edge_rmse(filtered, edges), mixed_all = b.edge_rmse(mixed, edges);
+  ASSERT_GT(count, 80);
+  std::printf(
+      "[ measure  ] tilted board, one grey, filtered Normal pass: edges of the front face and the "
+      "wall alone (%d px) RMSE %.4f with the pixel filter, %.4f with the Normal pass's "
+      "coverage; all edges (%d px) %.4f, %.4f\n",
+      count, filtered_rmse, mixed_rmse, edges, filtered_all, mixed_all);
+  EXPECT_LT(mixed_rmse, 0.85 * filtered_rmse);
+  EXPECT_LT(mixed_all, filtered_all);
+  int changed_inside = 0;
+  for (size_t i = 0; i < mixed.size(); ++i) changed_inside += !b.edge[i] && mixed[i] != filtered[i];
+  EXPECT_EQ(changed_inside, 0) << "only pixels on a depth edge change";
+  // Each pixel centre's normal, not filtered, says nothing of coverage.
+  EXPECT_EQ(with("beauty", centre_normals), with("none", centre_normals));
 }
 
 // A renderer's Normal pass is filtered over each pixel like the beauty: on a crease it holds the
