@@ -180,6 +180,7 @@ class Frame {
   void infer_last_thickness(TilePool& pool, Progress& progress);
   // Fills plane_distance_scale_ from the finished depth and normal planes.
   void measure_plane_distance_scale(TilePool& pool, Progress& progress);
+  void plane_distance_scale_row(int x0, int count, int y, float* out) const;
   static void hidden_last_fronts(const float* layers, size_t plane, int extra_layers, int count,
                                  float* last);
   static bool search_step(const float* last, const float* visible, const float* layers,
