@@ -116,8 +116,7 @@ void render_image(const Options& o, const RenderSetup& setup, const AnimationFra
   report_camera(o, scene, width, height, report);
 
   ScratchFolder scratch;
-  PassRunner povray = make_pass_runner(povray_settings, setup, frame, scratch);
-  povray.one_at_a_time = !scene.scan.file_write.empty();
+  const PassRunner povray = make_pass_runner(povray_settings, setup, frame, scratch, &scene.scan);
   KeepFiles keep(scratch, o.keep, report);
   // The data passes libssao reads (depth, normals) see a band around the frame: occluders just
   // outside it darken its edges. The beauty and the ambient pass are the frame.

@@ -206,7 +206,8 @@ int guard_band(const std::optional<int>& overscan, bool depth_only, int width, i
 }
 
 PassRunner make_pass_runner(const PassRunnerSettings& settings, const RenderSetup& setup,
-                            const AnimationFrame* frame, const ScratchFolder& scratch) {
+                            const AnimationFrame* frame, const ScratchFolder& scratch,
+                            const SceneScan* scan) {
   const PovrayArguments& user = settings.arguments;
   PassRunner povray;
   povray.executable = find_executable(settings.executable);
@@ -218,6 +219,8 @@ PassRunner make_pass_runner(const PassRunnerSettings& settings, const RenderSetu
   povray.scratch = &scratch;
   povray.frame = frame;
   povray.keep = settings.keep;
+  // Runs of a scene that writes files while it parses share them: one after another.
+  povray.one_at_a_time = scan != nullptr && !scan->file_write.empty();
   return povray;
 }
 
@@ -238,15 +241,15 @@ ImageScene read_image_scene(const CameraOverrides& camera_flags, bool print_came
     // own message says what is wrong, and where. --print-camera renders nothing.
     if (!print_camera) {
       ScratchFolder scratch;
-      check_scene_parses(make_pass_runner(povray, setup, frame, scratch), setup.scene_name, report);
+      check_scene_parses(make_pass_runner(povray, setup, frame, scratch, nullptr), setup.scene_name,
+                         report);
     }
     throw;
   }
   if (scene.reading.default_camera && !camera_flags.any() && !print_camera) {
     ScratchFolder scratch;
-    PassRunner runner = make_pass_runner(povray, setup, frame, scratch);
-    runner.one_at_a_time = !scene.scan.file_write.empty();
-    check_default_camera(runner, setup.scene_name, scene.scan, scene.reading.camera, setup.width,
+    check_default_camera(make_pass_runner(povray, setup, frame, scratch, &scene.scan),
+                         setup.scene_name, scene.scan, scene.reading.camera, setup.width,
                          setup.height, report);
   }
   return scene;

@@ -71,9 +71,11 @@ struct PassRunnerSettings {
 };
 
 // The runner of an image's povray runs: in the scene's folder, with the user's --ini and
-// options, an animation frame alone, the files in `scratch`.
+// options, an animation frame alone, the files in `scratch`; one run after another when the
+// scan found that parsing the scene writes a file (null: a single run, nothing shared).
 PassRunner make_pass_runner(const PassRunnerSettings& settings, const RenderSetup& setup,
-                            const AnimationFrame* frame, const ScratchFolder& scratch);
+                            const AnimationFrame* frame, const ScratchFolder& scratch,
+                            const SceneScan* scan);
 
 // The scene as one image (a still, or an animation's frame) sees it.
 struct ImageScene {
