@@ -47,6 +47,10 @@ struct HemisphereRowArgs {
   const float* lane_cones;
   float half_inv_end_width;  // 0.5 / the cone's width at the radius
 };
+
+// A surface the crossing test finds at the crossing point, up to its tolerance behind the crossed
+// plane, is that plane's own surface when its normal lies within 60 degrees of the plane's.
+constexpr float kSamePlaneCos = 0.5f;
 }  // namespace ssao
 #endif
 
@@ -54,6 +58,23 @@ HWY_BEFORE_NAMESPACE();
 namespace ssao {
 namespace HWY_NAMESPACE {
 namespace hn = hwy::HWY_NAMESPACE;
+
+// Whether the packed normals at `index` lie within 60 degrees of direction (cx, cy, cz), whose
+// squared length is cc (kSamePlaneCos).
+template <class VF, class VI>
+HWY_INLINE auto normal_agrees_lanes(const HemisphereRowArgs& a, VI index, VF cx, VF cy, VF cz,
+                                    VF cc) {
+  namespace hn = hwy::HWY_NAMESPACE;
+  const hn::DFromV<VF> df;
+  const hn::RebindToSigned<decltype(df)> di;
+  VF nx, ny, nz;
+  decode_directions(df, hn::GatherIndex(di, reinterpret_cast<const int32_t*>(a.normals), index), nx,
+                    ny, nz);
+  const VF along = hn::MulAdd(nx, cx, hn::MulAdd(ny, cy, nz * cz));
+  const VF nn = hn::MulAdd(nx, nx, hn::MulAdd(ny, ny, nz * nz));
+  return hn::And(hn::Gt(along, hn::Zero(df)),
+                 hn::Gt(along * along, hn::Set(df, kSamePlaneCos * kSamePlaneCos) * nn * cc));
+}
 
 // Hemisphere::shows_plane on the lanes of `candidate`: where the depth image shows the plane
 // dot(x, c) = w, or something in front of it, at the pixel of point (px, py, pz).
@@ -63,31 +84,60 @@ HWY_INLINE M plane_shown_lanes(const HemisphereRowArgs& a, const LaneProjection<
   namespace hn = hwy::HWY_NAMESPACE;
   const hn::DFromV<VF> df;
   const hn::RebindToSigned<decltype(df)> di;
+  using VI = hn::Vec<decltype(di)>;
   const CameraIntrinsics& cam = a.camera;
-  const VF one = hn::Set(df, 1.0f);
+  const VF one = hn::Set(df, 1.0f), zero = hn::Zero(df);
+  const VF tolerance = hn::Set(df, a.crossing_tolerance);
   VF cu, cv;
   const auto lanes = hn::And(candidate, project(px, py, pz, cu, cv));
   if (hn::AllFalse(df, lanes)) return lanes;
-  const auto qx = hn::ConvertTo(di, hn::IfThenElseZero(lanes, cu));
-  const auto qy = hn::ConvertTo(di, hn::IfThenElseZero(lanes, cv));
+  const VI qx = hn::ConvertTo(di, hn::IfThenElseZero(lanes, cu));
+  const VI qy = hn::ConvertTo(di, hn::IfThenElseZero(lanes, cv));
   // (qx, qy) are 0 on lanes outside the image: every index is in the plane.
-  const VF depth = hn::GatherIndex(df, a.depth, qy * hn::Set(di, a.width) + qx);
-  // The plane meets the ray through that pixel's centre, origin o + depth * direction r, at
-  // depth numerator / slope; the surface shown there is on or in front of it when
-  // depth * slope <= numerator + tolerance * slope (slope > 0; both sides negated otherwise).
-  VF u, v;
-  project.pixel_ray(qx, qy, u, v);
-  VF numerator = w, slope = hn::Neg(cz);  // orthographic: o = (u, v, 0), r = (0, 0, -1)
-  if (cam.orthographic) {
-    numerator = w - hn::MulAdd(u, cx, v * cy);
-  } else {  // o = 0, r = (u, v, -1)
-    slope = hn::MulAdd(u, cx, hn::MulSub(v, cy, cz));
+  // The plane meets the ray through pixel (x, y)'s centre, origin o + depth * direction r, at
+  // depth numerator / slope. Returns (depth - numerator / slope) * |slope|: how far the surface
+  // at `depth` lies behind the plane, times |slope|.
+  const auto behind_plane = [&](VI x, VI y, VF depth, VF& abs_slope) {
+    VF u, v;
+    project.pixel_ray(x, y, u, v);
+    VF numerator = w, slope = hn::Neg(cz);  // orthographic: o = (u, v, 0), r = (0, 0, -1)
+    if (cam.orthographic) {
+      numerator = w - hn::MulAdd(u, cx, v * cy);
+    } else {  // o = 0, r = (u, v, -1)
+      slope = hn::MulAdd(u, cx, hn::MulSub(v, cy, cz));
+    }
+    abs_slope = hn::Abs(slope);
+    return hn::NegMulAdd(numerator, hn::CopySign(one, slope), depth * abs_slope);
+  };
+  const VI index = qy * hn::Set(di, a.width) + qx;
+  VF abs_slope;
+  const VF behind = behind_plane(qx, qy, hn::GatherIndex(df, a.depth, index), abs_slope);
+  const auto shown = hn::And(hn::And(lanes, hn::Gt(abs_slope, hn::Set(df, 1e-6f))),
+                             hn::Le(behind, tolerance * abs_slope));
+  // A surface just behind the plane may be another one that meets the plane there (the floor
+  // where a box's side, carried on past the box, would meet it): it is the plane's own where its
+  // normal agrees, or where a neighbouring pixel shows the plane with such a normal.
+  auto unsure = hn::And(shown, hn::Gt(behind, zero));
+  if (hn::AllFalse(df, unsure)) return shown;
+  const VF cc = hn::MulAdd(cx, cx, hn::MulAdd(cy, cy, cz * cz));
+  unsure = hn::AndNot(normal_agrees_lanes(a, index, cx, cy, cz, cc), unsure);
+  if (hn::AllFalse(df, unsure)) return shown;
+  auto found = hn::Lt(one, zero);  // all false
+  const VI last_x = hn::Set(di, a.width - 1), last_y = hn::Set(di, a.height - 1);
+  static constexpr int kNeighbours[4][2] = {{1, 0}, {-1, 0}, {0, 1}, {0, -1}};
+  for (const auto& step : kNeighbours) {
+    const VI nx = hn::Min(hn::Max(qx + hn::Set(di, step[0]), hn::Zero(di)), last_x);
+    const VI ny = hn::Min(hn::Max(qy + hn::Set(di, step[1]), hn::Zero(di)), last_y);
+    const VI neighbour =
+        hn::IfThenElseZero(hn::RebindMask(di, unsure), ny * hn::Set(di, a.width) + nx);
+    VF neighbour_slope;
+    const VF off = behind_plane(nx, ny, hn::GatherIndex(df, a.depth, neighbour), neighbour_slope);
+    const auto on_plane = hn::And(hn::And(unsure, hn::Gt(neighbour_slope, hn::Set(df, 1e-6f))),
+                                  hn::Le(hn::Abs(off), tolerance * neighbour_slope));
+    if (hn::AllFalse(df, on_plane)) continue;
+    found = hn::Or(found, hn::And(on_plane, normal_agrees_lanes(a, neighbour, cx, cy, cz, cc)));
   }
-  const VF sign = hn::CopySign(one, slope);
-  const VF abs_slope = hn::Abs(slope);
-  return hn::And(hn::And(lanes, hn::Gt(abs_slope, hn::Set(df, 1e-6f))),
-                 hn::Le(depth * abs_slope, hn::MulAdd(hn::Set(df, a.crossing_tolerance), abs_slope,
-                                                      numerator * sign)));
+  return hn::AndNot(hn::AndNot(found, unsure), shown);
 }
 
 // Hemisphere::end_part on lanes: the part of a direction's cone at the radius past a plane,
@@ -781,18 +831,46 @@ class Hemisphere final : public Variant {
   }
 
   // Whether the depth image, at the pixel of point c (on the plane through q with normal nq),
-  // shows that plane or something in front of it.
+  // shows that plane or something in front of it. A surface up to the tolerance behind the plane
+  // may be another one that meets the plane there (the floor where a box's side, carried on past
+  // the box, would meet it): it counts where its normal agrees with the plane's, or where a
+  // neighbouring pixel shows the plane with such a normal.
   bool shows_plane(const Frame& f, Vec3 c, Vec3 q, Vec3 nq) const {
     int cx, cy;
-    if (!pixel_of_sample(f, c, cx, cy) || !f.is_geometry(cx, cy)) return false;
-    // The plane's depth on the ray through that pixel's centre.
+    float behind = 0.0f;
+    if (!pixel_of_sample(f, c, cx, cy) || !behind_plane(f, cx, cy, q, nq, behind) ||
+        behind > crossing_tolerance_) {
+      return false;
+    }
+    if (behind <= 0.0f || same_plane(f.normal(cx, cy), nq)) return true;
+    static constexpr int kNeighbours[4][2] = {{1, 0}, {-1, 0}, {0, 1}, {0, -1}};
+    for (const auto& step : kNeighbours) {
+      const int nx = std::clamp(cx + step[0], 0, f.width() - 1);
+      const int ny = std::clamp(cy + step[1], 0, f.height() - 1);
+      float off = 0.0f;
+      if (behind_plane(f, nx, ny, q, nq, off) && std::fabs(off) <= crossing_tolerance_ &&
+          same_plane(f.normal(nx, ny), nq)) {
+        return true;
+      }
+    }
+    return false;
+  }
+
+  // How far the surface pixel (x, y) shows lies behind the plane through q with normal nq, along
+  // the ray through the pixel's centre; false on background or a ray along the plane.
+  static bool behind_plane(const Frame& f, int x, int y, Vec3 q, Vec3 nq, float& behind) {
+    if (!f.is_geometry(x, y)) return false;
     const CameraModel& cam = f.camera();
-    const float u = float(cx) + 0.5f, v = float(cy) + 0.5f;
+    const float u = float(x) + 0.5f, v = float(y) + 0.5f;
     const Vec3 origin = cam.view_position(u, v, 0.0f);
     const float slope = dot(cam.view_position(u, v, 1.0f) - origin, nq);
     if (!(std::fabs(slope) > 1e-6f)) return false;
-    const float plane_depth = dot(q - origin, nq) / slope;
-    return f.depth(cx, cy) <= plane_depth + crossing_tolerance_;
+    behind = f.depth(x, y) - dot(q - origin, nq) / slope;
+    return true;
+  }
+
+  static bool same_plane(Vec3 n, Vec3 nq) {
+    return dot(n, nq) > kSamePlaneCos * length(n) * length(nq);
   }
 
   float radius_, bias_, thickness_, crossing_tolerance_;
