@@ -101,7 +101,6 @@ SSAO_VECTORIZE void Frame::plane_distance_scale_row(int x0, int count, int y,
 void Frame::infer_last_thickness(TilePool& pool, Progress& progress) {
   last_thickness_.resize(extra_layers_ > 0 ? pixel_count() : 0);
   if (extra_layers_ == 0) return;
-  static constexpr int kDirections[4][2] = {{1, 0}, {-1, 0}, {0, 1}, {0, -1}};
   pool.for_each_tile(width_, height_, progress, [&](const Tile& t) {
     const int count = t.x1 - t.x0;
     ScratchVector<float> last(count), stopped(count);
@@ -116,7 +115,7 @@ void Frame::infer_last_thickness(TilePool& pool, Progress& progress) {
       if (first == count) continue;
       const int end =
           count - int(std::find_if(last.rbegin(), last.rend(), has_front) - last.rbegin());
-      for (const auto& direction : kDirections) {
+      for (const auto& direction : kFourNeighbours) {
         std::fill_n(stopped.data(), count, 0.0f);
         // The span [from, to) of the pixels that may still walk: a pixel outside it has stopped,
         // has no hidden front, or has its neighbour outside the row from now on (the shift grows).

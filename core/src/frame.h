@@ -69,6 +69,9 @@ inline Vec3 decode_normal(uint32_t bits) {
   return n * (1.0f / std::sqrt(dot(n, n)));
 }
 
+// The offsets (dx, dy) of a pixel's four neighbours: right, left, below, above.
+inline constexpr int kFourNeighbours[4][2] = {{1, 0}, {-1, 0}, {0, 1}, {0, -1}};
+
 class Frame {
  public:
   static constexpr float kBackground = std::numeric_limits<float>::infinity();

@@ -205,7 +205,6 @@ void mix_edges_by_beauty(const Frame& frame, const ImageView& beauty, const Imag
   const auto inside = [&](int x, int y) {
     return x >= 0 && y >= 0 && x < frame.width() && y < frame.height() && frame.is_geometry(x, y);
   };
-  static constexpr int kSteps[4][2] = {{1, 0}, {-1, 0}, {0, 1}, {0, -1}};
   // Jumps to the right and below of the pixels in rows t.y0 - 1 .. t.y1 - 1 and columns
   // t.x0 - 1 .. t.x1 - 1 (clipped to the frame): a pixel is a candidate when it, its left or its
   // upper neighbour has a flag.
@@ -237,7 +236,7 @@ void mix_edges_by_beauty(const Frame& frame, const ImageView& beauty, const Imag
       // The neighbour across the largest jump.
       int sx = 0, sy = 0;
       float largest = 0.0f;
-      for (const auto& s : kSteps) {
+      for (const auto& s : kFourNeighbours) {
         if (!inside(x + s[0], y + s[1])) continue;
         const float other = frame.depth(x + s[0], y + s[1]);
         const float jump = std::fabs(depth - other) / std::min(depth, other);

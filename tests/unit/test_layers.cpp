@@ -646,8 +646,7 @@ TEST(Layers, ABoxCornerDrawsNoWedgeOnTheFloorBesideIt) {
   Camera cam;
   cam.width = 384, cam.height = 288;
   const V3 up = normalized({0, std::cos(M_PI / 6), std::sin(M_PI / 6)}), across{1, 0, 0};
-  const V3 away{up.y * across.z - up.z * across.y, up.z * across.x - up.x * across.z,
-                up.x * across.y - up.y * across.x};  // up x across: in the floor
+  const V3 away = ssao::cross(up, across);  // in the floor
   const double turn = M_PI / 6;
   const V3 side_a = across * std::cos(turn) + away * std::sin(turn);
   const V3 side_b = across * -std::sin(turn) + away * std::cos(turn);

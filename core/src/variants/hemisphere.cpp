@@ -22,6 +22,7 @@
 #include <limits>
 
 #include "camera.h"
+#include "frame.h"
 #include "sampling.h"
 #include "variants/lane_table.h"
 
@@ -124,8 +125,7 @@ HWY_INLINE M plane_shown_lanes(const HemisphereRowArgs& a, const LaneProjection<
   if (hn::AllFalse(df, unsure)) return shown;
   auto found = hn::Lt(one, zero);  // all false
   const VI last_x = hn::Set(di, a.width - 1), last_y = hn::Set(di, a.height - 1);
-  static constexpr int kNeighbours[4][2] = {{1, 0}, {-1, 0}, {0, 1}, {0, -1}};
-  for (const auto& step : kNeighbours) {
+  for (const auto& step : kFourNeighbours) {
     const VI nx = hn::Min(hn::Max(qx + hn::Set(di, step[0]), hn::Zero(di)), last_x);
     const VI ny = hn::Min(hn::Max(qy + hn::Set(di, step[1]), hn::Zero(di)), last_y);
     const VI neighbour =
@@ -843,8 +843,7 @@ class Hemisphere final : public Variant {
       return false;
     }
     if (behind <= 0.0f || same_plane(f.normal(cx, cy), nq)) return true;
-    static constexpr int kNeighbours[4][2] = {{1, 0}, {-1, 0}, {0, 1}, {0, -1}};
-    for (const auto& step : kNeighbours) {
+    for (const auto& step : kFourNeighbours) {
       const int nx = std::clamp(cx + step[0], 0, f.width() - 1);
       const int ny = std::clamp(cy + step[1], 0, f.height() - 1);
       float off = 0.0f;
