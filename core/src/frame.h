@@ -112,6 +112,21 @@ class Frame {
   }
   Vec3 normal(int x, int y) const { return decode_normal(normal_[index(x, y)]); }
   const uint32_t* normal_plane() const { return normal_.data(); }
+  // The normal of the surface the depth shows, for the tests of what lies above a receiver's
+  // tangent plane: the normal, except where a normal image's tilts across a straight stretch of
+  // the surface (a smooth-shaded mesh interpolates its vertex normals over each face; see
+  // frame.cpp). Computed when asked; the hemisphere's vector path computes the same on its lanes.
+  Vec3 surface_normal(int x, int y) const;
+  // 1 where the normal image's normal was a mix of surfaces (a crease or a silhouette: left to
+  // unmix_normals), else 0.
+  const uint8_t* mixed_normal_plane() const { return mixed_normal_.data(); }
+  // Whether the normals came from a normal image (else from the depth: on its surface already).
+  bool normals_from_image() const { return normals_from_image_; }
+  // surface_normal's thresholds: a tilt of more than 10 degrees (sin^2), across a stretch of three
+  // pixels turning by less than 10 degrees (cos^2) and at most 8 footprints long.
+  static constexpr float kSurfaceTiltSin2 = 0.0301536896f;
+  static constexpr float kStraightCos2 = 0.9698463104f;
+  static constexpr float kStretchFootprints = 8.0f;
 
   // Whether one of the (up to 8) pixels around (x, y) is background.
   bool beside_background(int x, int y) const;
@@ -203,6 +218,7 @@ class Frame {
   // 1 where the normal image's normal was shorter than kMixedNormalLength (a pixel filtered over
   // two surfaces), else 0 (background pixels may have either); sized with normal_.
   std::vector<uint8_t> mixed_normal_;
+  bool normals_from_image_ = false;  // the normals came from a normal image, not the depth
   std::vector<float> layers_;
   std::vector<float> last_thickness_;
   std::vector<float> plane_distance_scale_;

@@ -737,3 +737,81 @@ TEST(Analytic, AntiAliasedNormalsOnACreaseDoNotLightenIt) {
   twice.width *= 2, twice.height *= 2;
   expect_anti_aliased_normals_keep_the_crease(twice, "perspective", "half");
 }
+
+// A smooth-shaded mesh's Normal pass interpolates vertex normals over each face, so on a box or
+// a capped cylinder with "Shade Smooth" the normals tilt by up to 45 degrees from the face the
+// depth shows (in Blender 3.4, a capped 16-segment cylinder's side: 30 to 40 degrees near its
+// top). Cycles samples its AO around the tilted normal, but its own face does not occlude it: on
+// an open face tilted away from anything it reads 1. The tilt must orient the hemisphere and not
+// put the face above its own tangent plane.
+// Turns normal n (3 floats) about the view x axis by `degrees` (positive: towards -y).
+void turn_down(float* n, double degrees) {
+  const double a = degrees * M_PI / 180, ny = n[1], nz = n[2];
+  n[1] = float(ny * std::cos(a) + nz * std::sin(a));
+  n[2] = float(-ny * std::sin(a) + nz * std::cos(a));
+}
+
+void tilt_rows(Scene& s, double top_degrees, double bottom_degrees) {
+  for (int y = 0; y < s.height; ++y) {
+    for (int x = 0; x < s.width; ++x) {
+      turn_down(&s.normal[3 * (size_t(y) * s.width + x)],
+                top_degrees + (bottom_degrees - top_degrees) * y / (s.height - 1));
+    }
+  }
+}
+
+void expect_tilted_normals_leave_an_open_face_open(const Camera& cam, const char* label,
+                                                   const char* resolution) {
+  const auto with_resolution = [&](Job& j) { j.set("resolution", resolution); };
+  for (double face : {0.0, 40.0}) {  // facing the camera, and turned 40 degrees down
+    Scene s = tilted_plane(cam, face);
+    tilt_rows(s, -40.0, 40.0);
+    const auto ao = compute_ao(s, cam, 1.0, "hemisphere", true, with_resolution);
+    const Stats st = stats_over(s, ao, everywhere);
+    std::printf(
+        "[ measure  ] open face at %.0f degrees, normals tilted -40..40 degrees, %s %s: "
+        "AO min %.4f mean %.4f (true AO 1)\n",
+        face, label, resolution, st.min, st.mean);
+    ASSERT_GT(st.count, s.width * s.height / 4) << label;
+    EXPECT_GE(st.min, 0.98) << label << " " << resolution << " face " << face;
+  }
+}
+
+TEST(Analytic, SmoothShadingTiltsDoNotOccludeTheirOwnFace) {
+  expect_tilted_normals_leave_an_open_face_open(perspective(), "perspective", "full");
+  expect_tilted_normals_leave_an_open_face_open(orthographic_like_perspective(), "orthographic",
+                                                "full");
+  Camera twice = perspective();
+  twice.width *= 2, twice.height *= 2;
+  expect_tilted_normals_leave_an_open_face_open(twice, "perspective", "half");
+}
+
+// ... while a tilt towards an occluder still orients the hemisphere towards it (Cycles: the
+// bottom of that smooth-shaded cylinder, its normals tilted down to the floor, reads 0.30 where
+// a flat-shaded twin reads 0.62).
+TEST(Analytic, SmoothShadingTiltsStillTurnTheHemisphere) {
+  const Camera cam = perspective();
+  Scene flat = floor_and_wall(cam);
+  Scene tilted = flat;
+  // The wall's normals (the upper rows) tilted 30 degrees down, towards the floor.
+  for (int y = 0; y < tilted.height; ++y) {
+    for (int x = 0; x < tilted.width; ++x) {
+      const size_t i = size_t(y) * tilted.width + x;
+      if (!std::isfinite(tilted.depth[i]) || tilted.normal[3 * i + 1] > 0.5f) continue;
+      turn_down(&tilted.normal[3 * i], -30.0);
+    }
+  }
+  const auto ao_flat = compute_ao(flat, cam, 1.0, "hemisphere");
+  const auto ao_tilted = compute_ao(tilted, cam, 1.0, "hemisphere");
+  const auto on_wall = [&](int x, int y) {
+    const size_t i = size_t(y) * flat.width + x;
+    return std::isfinite(flat.depth[i]) && flat.normal[3 * i + 1] <= 0.5f;
+  };
+  const Stats f = stats_over(flat, ao_flat, on_wall), t = stats_over(tilted, ao_tilted, on_wall);
+  std::printf(
+      "[ measure  ] wall above a floor: mean AO %.4f, normals tilted 30 degrees down "
+      "%.4f\n",
+      f.mean, t.mean);
+  ASSERT_GT(f.count, 100);
+  EXPECT_LT(t.mean, f.mean - 0.02);
+}

@@ -317,7 +317,7 @@ struct PreparedFrame {
 // 2nd and 3rd hits:
 // `facing` says whether their facing images are given or taken to alternate.
 void prepare(PreparedFrame& out, const Camera& cam, const char* variant, bool layers = false,
-             bool facing = true) {
+             bool facing = true, bool tilted = false) {
   Camera c = cam;
   c.width = 101;
   c.height = 67;
@@ -332,6 +332,17 @@ void prepare(PreparedFrame& out, const Camera& cam, const char* variant, bool la
   }
   static Scene s;  // the frame's images must outlive build(): kept until the next prepare()
   s = ray_cast(c, solids);
+  if (tilted) {  // the floor's normals tilted as a smooth-shaded mesh's (Frame::surface_normal)
+    for (int y = 0; y < s.height; ++y) {
+      for (int x = 0; x < s.width; ++x) {
+        float* n = &s.normal[3 * (size_t(y) * s.width + x)];
+        if (!(n[1] > 0.9f)) continue;
+        const double a = 0.5 * std::sin(x / 7.0), ny = n[1], nz = n[2];
+        n[1] = float(ny * std::cos(a) + nz * std::sin(a));
+        n[2] = float(-ny * std::sin(a) + nz * std::cos(a));
+      }
+    }
+  }
   out.values.set_string("variant", variant);
   out.values.set_string("camera_type", c.ortho ? "ORTHO" : "PERSP");
   out.values.set_float("lens", c.lens);
@@ -473,7 +484,7 @@ TEST(Frame, LastThicknessIsMeasuredWhereNeighboursSeeTheSolidHiddenToo) {
 TEST(FastPath, EveryVariantMatchesItsScalarReference) {
   struct Case {
     const char* name;
-    bool layers, facing;
+    bool layers, facing, tilted = false;
   };
   std::vector<Case> cases;
   for (const ssao::VariantInfo& info : ssao::variant_registry())
@@ -481,10 +492,13 @@ TEST(FastPath, EveryVariantMatchesItsScalarReference) {
   // The variants that read extra depth layers, with and without facing images.
   cases.push_back({"hemisphere", true, true});
   cases.push_back({"hemisphere", true, false});
+  // Normals that tilt across their surface: the tangent-plane tests read the surface's.
+  cases.push_back({"hemisphere", false, false, true});
+  cases.push_back({"hemisphere", true, true, true});
   for (const Case& info : cases) {
     for (const Camera& cam : {Camera{}, Camera{true}}) {
       PreparedFrame p;
-      prepare(p, cam, info.name, info.layers, info.facing);
+      prepare(p, cam, info.name, info.layers, info.facing, info.tilted);
       const auto fast = estimate(p, false, whole(p.frame));
       const auto reference = estimate(p, true, whole(p.frame));
       size_t differ = 0, geometry = 0;
@@ -496,10 +510,11 @@ TEST(FastPath, EveryVariantMatchesItsScalarReference) {
         differ += d > 1e-3 ? 1 : 0;
         geometry += std::isfinite(p.frame.depth_plane()[i]) ? 1 : 0;
       }
-      std::printf("[ measure  ] %s%s %s: %zu of %zu geometry pixels differ by > 1e-3, max %.5f\n",
+      std::printf("[ measure  ] %s%s%s %s: %zu of %zu geometry pixels differ by > 1e-3, max %.5f\n",
                   info.name,
                   info.layers ? (info.facing ? " +layers" : " +layers (alternating)") : "",
-                  cam.ortho ? "ortho" : "persp", differ, geometry, worst);
+                  info.tilted ? " +tilted normals" : "", cam.ortho ? "ortho" : "persp", differ,
+                  geometry, worst);
       // The fast path fuses multiply-adds and refines a reciprocal estimate: rounding can move a
       // sample across a test's threshold, which changes one direction of one pixel (measured:
       // at most a handful of pixels), or move volumetric's chords a little (measured: at most

@@ -1,8 +1,8 @@
 // SPDX-License-Identifier: MIT
 // What the Highway kernels read from a Frame, in vector form: the packed octahedral normals
-// decoded (decode_normal in frame.h) and the camera model on lanes (LaneProjection: projection
-// and pixel rays). Included inside a kernel file's per-target pass (Highway's -inl.h
-// pattern: the guard toggles once per target).
+// decoded (decode_normal in frame.h), the camera model on lanes (LaneProjection: projection
+// and pixel rays) and Frame::surface_normal (surface_normal_lanes). Included inside a kernel file's
+// per-target pass (Highway's -inl.h pattern: the guard toggles once per target).
 #if defined(SSAO_FRAME_SIMD_INL_H_) == defined(HWY_TARGET_TOGGLE)
 #ifdef SSAO_FRAME_SIMD_INL_H_
 #undef SSAO_FRAME_SIMD_INL_H_
@@ -12,7 +12,10 @@
 
 #include <hwy/highway.h>
 
+#include <algorithm>
+
 #include "camera.h"
+#include "frame.h"
 
 HWY_BEFORE_NAMESPACE();
 namespace ssao {
@@ -95,6 +98,112 @@ struct LaneProjection {
                                      hn::And(hn::Lt(u, width), hn::Lt(v, height))));
   }
 };
+
+// Frame::surface_normal of pixels x .. x + lanes - 1 of row y (the lanes past the row's end are
+// background: their normal is kept), from the frame's depth plane `depth` (width x height, at
+// least 3 x 3), their depth d, normal n and mixed-normal flags: (gx, gy, gz).
+template <class VF, class M>
+HWY_INLINE void surface_normal_lanes(const LaneProjection<VF>& project, const float* depth,
+                                     int width, int height, int x, int y, VF d, VF nx, VF ny, VF nz,
+                                     M mixed, VF& gx, VF& gy, VF& gz) {
+  namespace hn = hwy::HWY_NAMESPACE;
+  const hn::DFromV<VF> df;
+  const hn::RebindToSigned<decltype(df)> di;
+  using VI = hn::Vec<decltype(di)>;
+  const int lanes = int(hn::Lanes(df));
+  gx = nx, gy = ny, gz = nz;
+  // The stretches along the row and the column, centred on the pixel or, on the frame's border,
+  // on its neighbour: depths a, m, b of each and the pixels' columns and rows.
+  const int cy = std::clamp(y, 1, height - 2);
+  const VI column = hn::Iota(di, x);
+  const VI cx = hn::Min(hn::Max(column, hn::Set(di, 1)), hn::Set(di, width - 2));
+  const VI inside_column = hn::Min(column, hn::Set(di, width - 1));
+  VF ax_d, mx_d, bx_d, ay_d, my_d, by_d;
+  if (x >= 1 && x + lanes <= width - 1 && y == cy) {
+    const float* at = depth + size_t(y) * width + x;
+    ax_d = hn::LoadU(df, at - 1), mx_d = d, bx_d = hn::LoadU(df, at + 1);
+    ay_d = hn::LoadU(df, at - width), my_d = d, by_d = hn::LoadU(df, at + width);
+  } else {
+    const VI row = hn::Set(di, y * width);
+    ax_d = hn::GatherIndex(df, depth, row + cx - hn::Set(di, 1));
+    mx_d = hn::GatherIndex(df, depth, row + cx);
+    bx_d = hn::GatherIndex(df, depth, row + cx + hn::Set(di, 1));
+    ay_d = hn::GatherIndex(df, depth, hn::Set(di, (cy - 1) * width) + inside_column);
+    my_d = hn::GatherIndex(df, depth, hn::Set(di, cy * width) + inside_column);
+    by_d = hn::GatherIndex(df, depth, hn::Set(di, (cy + 1) * width) + inside_column);
+  }
+  const VF one = hn::Set(df, 1.0f), zero = hn::Zero(df);
+  // CameraModel::view_position of pixel (qx, qy) at depth `at`.
+  const auto position = [&](VI qx, VI qy, VF at, VF& px, VF& py, VF& pz) {
+    project.pixel_ray(qx, qy, px, py);
+    const VF s = project.orthographic ? one : at;
+    px = px * s, py = py * s, pz = hn::Neg(at);
+  };
+  const VF reach =
+      hn::Set(df, Frame::kStretchFootprints) * project.scale_u * (project.orthographic ? one : d);
+  const VF reach2 = reach * reach;
+  // tilt_across in frame.cpp, in two parts: first whether n tilts across the chord a -> b (most
+  // lanes do not: nothing more is computed), then whether a -> m -> b is straight.
+  struct Stretch {
+    VF chord_x, chord_y, chord_z, tilt, ab2, along;
+    hn::Mask<decltype(df)> straight, tilts;
+  };
+  const auto chord = [&](VI qa_x, VI qa_y, VF a_d, VI qb_x, VI qb_y, VF b_d) {
+    VF ax, ay, az, bx, by, bz;
+    position(qa_x, qa_y, a_d, ax, ay, az);
+    position(qb_x, qb_y, b_d, bx, by, bz);
+    Stretch s;
+    s.chord_x = bx - ax, s.chord_y = by - ay, s.chord_z = bz - az;
+    s.tilt = s.chord_x * nx + s.chord_y * ny + s.chord_z * nz;
+    s.ab2 = s.chord_x * s.chord_x + s.chord_y * s.chord_y + s.chord_z * s.chord_z;
+    s.tilts = hn::Gt(s.tilt * s.tilt, hn::Set(df, Frame::kSurfaceTiltSin2) * s.ab2);
+    return s;
+  };
+  const VI row_y = hn::Set(di, y), row_cy = hn::Set(di, cy);
+  Stretch across = chord(cx - hn::Set(di, 1), row_y, ax_d, cx + hn::Set(di, 1), row_y, bx_d);
+  Stretch down =
+      chord(inside_column, hn::Set(di, cy - 1), ay_d, inside_column, hn::Set(di, cy + 1), by_d);
+  const auto candidate = hn::AndNot(mixed, hn::Or(across.tilts, down.tilts));
+  if (hn::AllFalse(df, candidate)) return;
+  const auto straight = [&](Stretch& s, VI qa_x, VI qa_y, VF a_d, VI qm_x, VI qm_y, VF m_d) {
+    VF ax, ay, az, mx, my, mz;
+    position(qa_x, qa_y, a_d, ax, ay, az);
+    position(qm_x, qm_y, m_d, mx, my, mz);
+    const VF max_ = mx - ax, may = my - ay, maz = mz - az;                          // m - a
+    const VF bmx = s.chord_x - max_, bmy = s.chord_y - may, bmz = s.chord_z - maz;  // b - m
+    const VF la2 = max_ * max_ + may * may + maz * maz, lb2 = bmx * bmx + bmy * bmy + bmz * bmz;
+    const VF turn = max_ * bmx + may * bmy + maz * bmz;
+    const VF longer = hn::Max(la2, lb2), shorter = hn::Min(la2, lb2);
+    s.straight =
+        hn::And(hn::And(hn::Gt(turn, zero),
+                        hn::Gt(turn * turn, hn::Set(df, Frame::kStraightCos2) * la2 * lb2)),
+                hn::And(hn::Lt(longer, hn::Set(df, 4.0f) * shorter), hn::Lt(longer, reach2)));
+    s.tilts = hn::And(s.straight, s.tilts);
+    s.along = hn::IfThenElseZero(s.tilts, s.tilt / hn::IfThenElse(s.tilts, s.ab2, one));
+  };
+  straight(across, cx - hn::Set(di, 1), row_y, ax_d, cx, row_y, mx_d);
+  straight(down, inside_column, hn::Set(di, cy - 1), ay_d, inside_column, row_cy, my_d);
+  const auto tilted = hn::AndNot(mixed, hn::Or(across.tilts, down.tilts));
+  if (hn::AllFalse(df, tilted)) return;
+  VF tx = nx - across.chord_x * across.along - down.chord_x * down.along;
+  VF ty = ny - across.chord_y * across.along - down.chord_y * down.along;
+  VF tz = nz - across.chord_z * across.along - down.chord_z * down.along;
+  // cross(down.chord, across.chord), turned to n's side.
+  VF px = down.chord_y * across.chord_z - down.chord_z * across.chord_y;
+  VF py = down.chord_z * across.chord_x - down.chord_x * across.chord_z;
+  VF pz = down.chord_x * across.chord_y - down.chord_y * across.chord_x;
+  const auto away = hn::Lt(px * nx + py * ny + pz * nz, zero);
+  px = hn::IfThenElse(away, hn::Neg(px), px), py = hn::IfThenElse(away, hn::Neg(py), py);
+  pz = hn::IfThenElse(away, hn::Neg(pz), pz);
+  const auto both = hn::And(across.straight, down.straight);
+  tx = hn::IfThenElse(both, px, tx), ty = hn::IfThenElse(both, py, ty);
+  tz = hn::IfThenElse(both, pz, tz);
+  const VF length2 = tx * tx + ty * ty + tz * tz;
+  const auto turned = hn::And(tilted, hn::Gt(length2, zero));
+  const VF inv = one / hn::Sqrt(hn::IfThenElse(turned, length2, one));
+  gx = hn::IfThenElse(turned, tx * inv, nx), gy = hn::IfThenElse(turned, ty * inv, ny);
+  gz = hn::IfThenElse(turned, tz * inv, nz);
+}
 
 }  // namespace HWY_NAMESPACE
 }  // namespace ssao

@@ -30,10 +30,12 @@ namespace ssao {
 struct HemisphereRowArgs {
   const float* depth;                 // the frame's depth plane
   const uint32_t* normals;            // the frame's packed normals
+  const uint8_t* mixed_normals;       // Frame::mixed_normal_plane
   const float* layers;                // the frame's extra depth layers (Frame::layer_planes)
   const float* last_thickness;        // Frame::last_thickness_plane
   const float* plane_distance_scale;  // Frame::plane_distance_scale_plane
   int extra_layers;
+  bool surface_normals;  // the tangent-plane tests use Frame::surface_normal (else the normal)
   int width, height;
   CameraIntrinsics camera;
   float radius, min_height_bias, thickness, crossing_tolerance;
@@ -278,18 +280,22 @@ HWY_NOINLINE void hemisphere_row_of(const HemisphereRowArgs& a, int y, int x0, i
 
   alignas(64) float depth_in[kMaxLanes];
   alignas(64) int32_t normal_in[kMaxLanes];
+  alignas(64) uint8_t mixed_in[kMaxLanes];
   alignas(64) float result[kMaxLanes];
   for (int x = x0; x < x1; x += lanes) {
     const int count = std::min(lanes, x1 - x);
     const float* depth_at = a.depth + size_t(y) * a.width + x;
     const uint32_t* normal_at = a.normals + size_t(y) * a.width + x;
+    const uint8_t* mixed_at = a.mixed_normals + size_t(y) * a.width + x;
     if (count < lanes) {  // stage the lanes, padding past the row's end with background
       for (int i = 0; i < lanes; ++i) {
         depth_in[i] = i < count ? depth_at[i] : std::numeric_limits<float>::infinity();
         normal_in[i] = i < count ? int32_t(normal_at[i]) : 0;
+        mixed_in[i] = i < count ? mixed_at[i] : 0;
       }
       depth_at = depth_in;
       normal_at = reinterpret_cast<const uint32_t*>(normal_in);
+      mixed_at = mixed_in;
     }
     const VF depth = hn::LoadU(df, depth_at);
     const VF footprint = cam.orthographic ? scale_u : scale_u * depth;
@@ -317,9 +323,18 @@ HWY_NOINLINE void hemisphere_row_of(const HemisphereRowArgs& a, int y, int x0, i
     const VF tx = one + sign * nx * nx * basis_a, ty = sign * basis_c, tz = hn::Neg(sign * nx);
     const VF bx = basis_c, by = sign + ny * ny * basis_a, bz = hn::Neg(ny);
 
-    // An occluder counts above the tangent plane: dot(q, n) > dot(p, n) + min_height.
+    // An occluder counts above the tangent plane of the surface (normal g): dot(q, g) >
+    // dot(p, g) + min_height.
+    VF gx = nx, gy = ny, gz = nz;
+    if (a.surface_normals) {
+      const hn::Rebind<uint8_t, decltype(di)> d8;
+      const auto mixed =
+          hn::RebindMask(df, hn::Ne(hn::PromoteTo(di, hn::LoadU(d8, mixed_at)), hn::Zero(di)));
+      surface_normal_lanes(project, a.depth, a.width, a.height, x, y, depth, nx, ny, nz, mixed, gx,
+                           gy, gz);
+    }
     const VF min_height = hn::Set(df, a.min_height_bias) + footprint;
-    const VF plane_level = hn::MulAdd(px, nx, hn::MulAdd(py, ny, hn::MulAdd(pz, nz, min_height)));
+    const VF plane_level = hn::MulAdd(px, gx, hn::MulAdd(py, gy, hn::MulAdd(pz, gz, min_height)));
     VF occlusion = zero, valid = zero;
     const float* offset = row_offsets;
     [[maybe_unused]] const float* cone = row_cones;
@@ -361,7 +376,7 @@ HWY_NOINLINE void hemisphere_row_of(const HemisphereRowArgs& a, int y, int x0, i
           const VF qxv = ray_x * q_scale, qyv = ray_y * q_scale;
           const VF qzv = hn::Neg(qd);
           const VF behind = qzv - sz;  // > 0: the visible surface is in front of the sample
-          const VF level = hn::MulAdd(qxv, nx, hn::MulAdd(qyv, ny, qzv * nz));
+          const VF level = hn::MulAdd(qxv, gx, hn::MulAdd(qyv, gy, qzv * gz));
           const auto counts = hn::And(hn::And(in_image, hn::Lt(qd, inf)),
                                       hn::And(hn::Gt(behind, zero), hn::Gt(level, plane_level)));
           const VF weight = hn::Min(one, hn::Max(zero, two - behind * inv_thickness));
@@ -380,7 +395,7 @@ HWY_NOINLINE void hemisphere_row_of(const HemisphereRowArgs& a, int y, int x0, i
           if (!hn::AllFalse(df, open_lanes)) {
             blocked = hn::Max(
                 blocked, between_lanes(a, project, open_lanes, (ax + sx) * half, (ay + sy) * half,
-                                       (az + sz) * half, end_x, end_y, end_z, nx, ny, nz,
+                                       (az + sz) * half, end_x, end_y, end_z, gx, gy, gz,
                                        plane_level, half_inv_width_between));
           }
           auto hidden = none;
@@ -400,7 +415,7 @@ HWY_NOINLINE void hemisphere_row_of(const HemisphereRowArgs& a, int y, int x0, i
             const auto surface = hn::And(in_image, hn::Lt(qd, inf));
             hidden = hn::And(surface, hn::Gt(behind, zero));
             above = hn::And(
-                surface, hn::Gt(hn::MulAdd(qxv, nx, hn::MulAdd(qyv, ny, qzv * nz)), plane_level));
+                surface, hn::Gt(hn::MulAdd(qxv, gx, hn::MulAdd(qyv, gy, qzv * gz)), plane_level));
             // The part of the sample's cone behind the visible surface (Hemisphere::covered): a
             // sample just in front of a surface above the tangent plane counts in part, one just
             // behind it not yet fully.
@@ -450,7 +465,7 @@ HWY_NOINLINE void hemisphere_row_of(const HemisphereRowArgs& a, int y, int x0, i
               // plane.
               const VF entry_scale = cam.orthographic ? one : entry;
               const VF ex = ray_x * entry_scale, ey = ray_y * entry_scale;
-              const VF entry_level = hn::MulAdd(ex, nx, hn::MulAdd(ey, ny, hn::Neg(entry) * nz));
+              const VF entry_level = hn::MulAdd(ex, gx, hn::MulAdd(ey, gy, hn::Neg(entry) * gz));
               const auto counts =
                   hn::And(hn::And(hidden, entered), hn::Gt(entry_level, plane_level));
               const VF thick =
@@ -608,10 +623,12 @@ class Hemisphere final : public Variant {
   void estimate(const Frame& f, const Tile& t, float* visibility) const override {
     const HemisphereRowArgs args{f.depth_plane(),
                                  f.normal_plane(),
+                                 f.mixed_normal_plane(),
                                  f.layer_planes(),
                                  f.last_thickness_plane(),
                                  f.plane_distance_scale_plane(),
                                  f.extra_layers(),
+                                 f.normals_from_image() && f.width() >= 3 && f.height() >= 3,
                                  f.width(),
                                  f.height(),
                                  f.camera().intrinsics(),
@@ -676,6 +693,7 @@ class Hemisphere final : public Variant {
   float pixel(const Frame& f, int x, int y) const {
     const Vec3 p = f.position(x, y);
     const Vec3 normal = f.normal(x, y);
+    const Vec3 geometric_normal = f.surface_normal(x, y);  // for the tangent-plane tests
     // Depth-aware bias: one pixel footprint covers depth quantisation and pixel snapping.
     const float min_height = bias_ * radius_ + f.camera().pixel_footprint(-p.z);
     Vec3 tangent, bitangent;
@@ -701,8 +719,9 @@ class Hemisphere final : public Variant {
         // The direction's end at the radius (with extra layers).
         const Vec3 end = layered ? sample + (sample - previous) * cone->extend : Vec3{};
         if (layered && blocked < 1.0f) {
-          blocked = std::max(blocked, between(f, p, normal, min_height, (previous + sample) * 0.5f,
-                                              end, cone->half_inv_width_between));
+          blocked = std::max(
+              blocked, between(f, p, geometric_normal, min_height, (previous + sample) * 0.5f, end,
+                               cone->half_inv_width_between));
         }
         int qx = -1, qy = -1;
         bool hidden = false, above = false;
@@ -712,7 +731,7 @@ class Hemisphere final : public Variant {
           if (f.is_geometry(qx, qy)) {
             surface = f.position(qx, qy);
             hidden = -sample.z > -surface.z;
-            above = dot(surface - p, normal) > min_height;
+            above = dot(surface - p, geometric_normal) > min_height;
             const float part = layered ? covered(f, qx, qy, sample, surface, *cone) : 1.0f;
             if (layered && !hidden && above) {
               blocked = std::max(blocked, part);
@@ -726,7 +745,7 @@ class Hemisphere final : public Variant {
               // the foreground for a hidden last hit, else assumed), when above the tangent
               // plane.
               const float measured = past_last ? f.last_thickness(qx, qy) : 0.0f;
-              if (dot(q - p, normal) > min_height) {
+              if (dot(q - p, geometric_normal) > min_height) {
                 const float weight =
                     closed ? 1.0f
                            : thickness_weight(-sample.z - entry,
