@@ -360,7 +360,11 @@ void Frame::unmix_normals(TilePool& pool, Progress& progress) {
 // at the frame's border) is the surface's where it is straight (its halves turn by less than 10
 // degrees, neither is more than twice as long as the other nor longer than kStretchFootprints
 // footprints: not a crease, not a silhouette; a 32-segment sphere's normals bend by 6 degrees
-// within a face). Where the normal tilts across one by more than 10 degrees, the surface normal
+// within a face) and the normals at its ends lie within 6 degrees of each other (interpolated
+// vertex normals turn slowly; a bump map's turn from pixel to pixel, and there Cycles does
+// occlude a closed object's face by itself: its rays below the face meet the object's inside,
+// where a smooth-shaded mesh's start on the shadow terminator's offset surface).
+// Where the normal tilts across one by more than 10 degrees, the surface normal
 // is the normal of the plane of both stretches when both are straight, else the normal without
 // its component along the one it tilts across (the surface curves across the other). Mixed
 // normals (creases, silhouettes) are unmix_normals' business.
@@ -371,14 +375,17 @@ namespace {
 struct Tilt {
   float along, straight, tilts;
 };
-Tilt tilt_across(Vec3 a, Vec3 m, Vec3 b, Vec3 n, float reach2) {
+Tilt tilt_across(Vec3 a, Vec3 m, Vec3 b, Vec3 n, Vec3 na, Vec3 nb, float reach2) {
   const Vec3 ma = m - a, bm = b - m, ab = b - a;
   const float la2 = dot(ma, ma), lb2 = dot(bm, bm), turn = dot(ma, bm);
   const float longer = std::max(la2, lb2), shorter = std::min(la2, lb2);
   const float tilt = dot(ab, n), ab2 = dot(ab, ab);
   const bool straight = turn > 0.0f && turn * turn > Frame::kStraightCos2 * la2 * lb2 &&
                         longer < 4.0f * shorter && longer < reach2;
-  const bool tilts = straight && tilt * tilt > Frame::kSurfaceTiltSin2 * ab2;
+  // The normals na, nb at both ends agree: the slow turn of interpolated vertex normals, not a
+  // bump map's.
+  const bool tilts = straight && tilt * tilt > Frame::kSurfaceTiltSin2 * ab2 &&
+                     dot(na, nb) > Frame::kSmoothNormalsCos;
   return {tilts ? tilt / ab2 : 0.0f, straight ? 1.0f : 0.0f, tilts ? 1.0f : 0.0f};
 }
 }  // namespace
@@ -393,8 +400,10 @@ Vec3 Frame::surface_normal(int x, int y) const {
   const int cx = std::clamp(x, 1, width_ - 2), cy = std::clamp(y, 1, height_ - 2);
   const Vec3 ax = position(cx - 1, y), bx = position(cx + 1, y);
   const Vec3 ay = position(x, cy - 1), by = position(x, cy + 1);
-  const Tilt across = tilt_across(ax, position(cx, y), bx, n, reach * reach);
-  const Tilt down = tilt_across(ay, position(x, cy), by, n, reach * reach);
+  const Tilt across =
+      tilt_across(ax, position(cx, y), bx, n, normal(cx - 1, y), normal(cx + 1, y), reach * reach);
+  const Tilt down =
+      tilt_across(ay, position(x, cy), by, n, normal(x, cy - 1), normal(x, cy + 1), reach * reach);
   if (across.tilts == 0.0f && down.tilts == 0.0f) return n;
   const Vec3 chord_x = bx - ax, chord_y = by - ay;
   Vec3 turned = n - chord_x * across.along - chord_y * down.along;

@@ -123,10 +123,12 @@ class Frame {
   // Whether the normals came from a normal image (else from the depth: on its surface already).
   bool normals_from_image() const { return normals_from_image_; }
   // surface_normal's thresholds: a tilt of more than 10 degrees (sin^2), across a stretch of three
-  // pixels turning by less than 10 degrees (cos^2) and at most 8 footprints long.
+  // pixels turning by less than 10 degrees (cos^2) and at most 8 footprints long, whose ends'
+  // normals lie within 6 degrees of each other (cos).
   static constexpr float kSurfaceTiltSin2 = 0.0301536896f;
   static constexpr float kStraightCos2 = 0.9698463104f;
   static constexpr float kStretchFootprints = 8.0f;
+  static constexpr float kSmoothNormalsCos = 0.9945218954f;
 
   // Whether one of the (up to 8) pixels around (x, y) is background.
   bool beside_background(int x, int y) const;

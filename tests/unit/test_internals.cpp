@@ -337,7 +337,7 @@ void prepare(PreparedFrame& out, const Camera& cam, const char* variant, bool la
       for (int x = 0; x < s.width; ++x) {
         float* n = &s.normal[3 * (size_t(y) * s.width + x)];
         if (!(n[1] > 0.9f)) continue;
-        const double a = 0.5 * std::sin(x / 7.0), ny = n[1], nz = n[2];
+        const double a = 0.5 * std::sin(x / 25.0), ny = n[1], nz = n[2];
         n[1] = float(ny * std::cos(a) + nz * std::sin(a));
         n[2] = float(-ny * std::sin(a) + nz * std::cos(a));
       }

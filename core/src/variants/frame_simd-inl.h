@@ -101,11 +101,11 @@ struct LaneProjection {
 
 // Frame::surface_normal of pixels x .. x + lanes - 1 of row y (the lanes past the row's end are
 // background: their normal is kept), from the frame's depth plane `depth` (width x height, at
-// least 3 x 3), their depth d, normal n and mixed-normal flags: (gx, gy, gz).
+// least 3 x 3) and packed normals, their depth d, normal n and mixed-normal flags: (gx, gy, gz).
 template <class VF, class M>
 HWY_INLINE void surface_normal_lanes(const LaneProjection<VF>& project, const float* depth,
-                                     int width, int height, int x, int y, VF d, VF nx, VF ny, VF nz,
-                                     M mixed, VF& gx, VF& gy, VF& gz) {
+                                     const uint32_t* normals, int width, int height, int x, int y,
+                                     VF d, VF nx, VF ny, VF nz, M mixed, VF& gx, VF& gy, VF& gz) {
   namespace hn = hwy::HWY_NAMESPACE;
   const hn::DFromV<VF> df;
   const hn::RebindToSigned<decltype(df)> di;
@@ -165,7 +165,8 @@ HWY_INLINE void surface_normal_lanes(const LaneProjection<VF>& project, const fl
       chord(inside_column, hn::Set(di, cy - 1), ay_d, inside_column, hn::Set(di, cy + 1), by_d);
   const auto candidate = hn::AndNot(mixed, hn::Or(across.tilts, down.tilts));
   if (hn::AllFalse(df, candidate)) return;
-  const auto straight = [&](Stretch& s, VI qa_x, VI qa_y, VF a_d, VI qm_x, VI qm_y, VF m_d) {
+  const auto straight = [&](Stretch& s, VI qa_x, VI qa_y, VF a_d, VI qm_x, VI qm_y, VF m_d, VI qb_x,
+                            VI qb_y) {
     VF ax, ay, az, mx, my, mz;
     position(qa_x, qa_y, a_d, ax, ay, az);
     position(qm_x, qm_y, m_d, mx, my, mz);
@@ -178,11 +179,20 @@ HWY_INLINE void surface_normal_lanes(const LaneProjection<VF>& project, const fl
         hn::And(hn::And(hn::Gt(turn, zero),
                         hn::Gt(turn * turn, hn::Set(df, Frame::kStraightCos2) * la2 * lb2)),
                 hn::And(hn::Lt(longer, hn::Set(df, 4.0f) * shorter), hn::Lt(longer, reach2)));
-    s.tilts = hn::And(s.straight, s.tilts);
+    // The normals at both ends agree: the slow turn of interpolated vertex normals, not a bump.
+    VF anx, any, anz, bnx, bny, bnz;
+    const int32_t* packed = reinterpret_cast<const int32_t*>(normals);
+    const VI w = hn::Set(di, width);
+    decode_normals(df, hn::GatherIndex(di, packed, qa_y * w + qa_x), anx, any, anz);
+    decode_normals(df, hn::GatherIndex(di, packed, qb_y * w + qb_x), bnx, bny, bnz);
+    const auto agree =
+        hn::Gt(anx * bnx + any * bny + anz * bnz, hn::Set(df, Frame::kSmoothNormalsCos));
+    s.tilts = hn::And(hn::And(s.straight, s.tilts), agree);
     s.along = hn::IfThenElseZero(s.tilts, s.tilt / hn::IfThenElse(s.tilts, s.ab2, one));
   };
-  straight(across, cx - hn::Set(di, 1), row_y, ax_d, cx, row_y, mx_d);
-  straight(down, inside_column, hn::Set(di, cy - 1), ay_d, inside_column, row_cy, my_d);
+  straight(across, cx - hn::Set(di, 1), row_y, ax_d, cx, row_y, mx_d, cx + hn::Set(di, 1), row_y);
+  straight(down, inside_column, hn::Set(di, cy - 1), ay_d, inside_column, row_cy, my_d,
+           inside_column, hn::Set(di, cy + 1));
   const auto tilted = hn::AndNot(mixed, hn::Or(across.tilts, down.tilts));
   if (hn::AllFalse(df, tilted)) return;
   VF tx = nx - across.chord_x * across.along - down.chord_x * down.along;

@@ -330,8 +330,8 @@ HWY_NOINLINE void hemisphere_row_of(const HemisphereRowArgs& a, int y, int x0, i
       const hn::Rebind<uint8_t, decltype(di)> d8;
       const auto mixed =
           hn::RebindMask(df, hn::Ne(hn::PromoteTo(di, hn::LoadU(d8, mixed_at)), hn::Zero(di)));
-      surface_normal_lanes(project, a.depth, a.width, a.height, x, y, depth, nx, ny, nz, mixed, gx,
-                           gy, gz);
+      surface_normal_lanes(project, a.depth, a.normals, a.width, a.height, x, y, depth, nx, ny, nz,
+                           mixed, gx, gy, gz);
     }
     const VF min_height = hn::Set(df, a.min_height_bias) + footprint;
     const VF plane_level = hn::MulAdd(px, gx, hn::MulAdd(py, gy, hn::MulAdd(pz, gz, min_height)));
