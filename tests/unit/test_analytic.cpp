@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <functional>
 
 #include "analytic_scene.h"
 
@@ -727,15 +728,20 @@ void expect_anti_aliased_normals_keep_the_crease(const Camera& cam, const char* 
   EXPECT_LT(std::sqrt(squared / n), 0.04) << label << " " << resolution;
 }
 
-TEST(Analytic, AntiAliasedNormalsOnACreaseDoNotLightenIt) {
-  expect_anti_aliased_normals_keep_the_crease(perspective(), "perspective", "full");
-  expect_anti_aliased_normals_keep_the_crease(orthographic_like_perspective(), "orthographic",
-                                              "full");
-  // At half resolution each 2x2 block takes its nearest pixel, which on a concave crease is
-  // rarely the crease's own: there the check is that the half frame's normals stay right.
+// Runs check(camera, label, resolution) in perspective and orthographic at full resolution, and
+// in perspective at half resolution on a frame twice the size.
+void in_each_view(const std::function<void(const Camera&, const char*, const char*)>& check) {
+  check(perspective(), "perspective", "full");
+  check(orthographic_like_perspective(), "orthographic", "full");
   Camera twice = perspective();
   twice.width *= 2, twice.height *= 2;
-  expect_anti_aliased_normals_keep_the_crease(twice, "perspective", "half");
+  check(twice, "perspective", "half");
+}
+
+// At half resolution each 2x2 block takes its nearest pixel, which on a concave crease is rarely
+// the crease's own: there the check is that the half frame's normals stay right.
+TEST(Analytic, AntiAliasedNormalsOnACreaseDoNotLightenIt) {
+  in_each_view(expect_anti_aliased_normals_keep_the_crease);
 }
 
 // A smooth-shaded mesh's Normal pass interpolates vertex normals over each face, so on a box or
@@ -778,12 +784,7 @@ void expect_tilted_normals_leave_an_open_face_open(const Camera& cam, const char
 }
 
 TEST(Analytic, SmoothShadingTiltsDoNotOccludeTheirOwnFace) {
-  expect_tilted_normals_leave_an_open_face_open(perspective(), "perspective", "full");
-  expect_tilted_normals_leave_an_open_face_open(orthographic_like_perspective(), "orthographic",
-                                                "full");
-  Camera twice = perspective();
-  twice.width *= 2, twice.height *= 2;
-  expect_tilted_normals_leave_an_open_face_open(twice, "perspective", "half");
+  in_each_view(expect_tilted_normals_leave_an_open_face_open);
 }
 
 // ... while a tilt towards an occluder still orients the hemisphere towards it (Cycles: the
