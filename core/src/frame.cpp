@@ -211,13 +211,23 @@ SSAO_VECTORIZE bool Frame::search_step(const float* __restrict last,
   return walking_on != 0;
 }
 
-bool Frame::beside_background(int x, int y) const {
-  for (int ny = std::max(y - 1, 0); ny <= std::min(y + 1, height_ - 1); ++ny) {
-    for (int nx = std::max(x - 1, 0); nx <= std::min(x + 1, width_ - 1); ++nx) {
-      if (!is_geometry(nx, ny)) return true;
-    }
+SSAO_VECTORIZE void Frame::beside_background_row(int y, int x0, int x1,
+                                                 uint8_t* __restrict beside) const {
+  const float* above = depth_.data() + index(0, std::max(y - 1, 0));
+  const float* row = depth_.data() + index(0, y);
+  const float* below = depth_.data() + index(0, std::min(y + 1, height_ - 1));
+  const auto sky = [&](int x) {
+    return int(above[x] == kBackground) | int(row[x] == kBackground) | int(below[x] == kBackground);
+  };
+  // The first and last columns have one neighbour column; the loop between reads x - 1 .. x + 1.
+  const int inner0 = std::max(x0, 1), inner1 = std::max(inner0, std::min(x1, width_ - 1));
+  for (int x = x0; x < inner0; ++x) {
+    beside[x - x0] = uint8_t(sky(x) | sky(std::min(x + 1, width_ - 1)));
   }
-  return false;
+  for (int x = inner0; x < inner1; ++x) {
+    beside[x - x0] = uint8_t(sky(x - 1) | sky(x) | sky(x + 1));
+  }
+  for (int x = inner1; x < x1; ++x) beside[x - x0] = uint8_t(sky(x - 1) | sky(x));
 }
 
 bool Frame::has_geometry(int x0, int y0, int x1, int y1) const {

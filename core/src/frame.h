@@ -130,8 +130,9 @@ class Frame {
   static constexpr float kStretchFootprints = 8.0f;
   static constexpr float kSmoothNormalsCos = 0.9945218954f;
 
-  // Whether one of the (up to 8) pixels around (x, y) is background.
-  bool beside_background(int x, int y) const;
+  // For pixels [x0, x1) of row y: 1 where one of the (up to 8) pixels around is background, else
+  // 0. A row at a time: the composite asks it of every pixel.
+  void beside_background_row(int y, int x0, int x1, uint8_t* beside) const;
 
   // Whether rows [y0, y1) x columns [x0, x1) show any geometry (false: all sky).
   bool has_geometry(int x0, int y0, int x1, int y1) const;

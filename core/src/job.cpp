@@ -185,11 +185,13 @@ void composite_row(const float* ao, const float* coverage, int count, const Imag
 // share of the pixel. A beauty with alpha below 1 (a transparent film) holds only what is not
 // transparent, premultiplied: the surface's share of that is length / alpha. Normals from
 // elsewhere than a pass (reconstructed) say nothing: 1.
+// beside: scratch for x1 - x0 flags.
 void coverage_row(const Frame& frame, const ImageView& normal, const ImageView& beauty, int x0,
-                  int x1, int y, int dx, int dy, float* coverage) {
+                  int x1, int y, int dx, int dy, uint8_t* beside, float* coverage) {
+  if (normal.attached()) frame.beside_background_row(y, x0, x1, beside);
   for (int x = x0; x < x1; ++x) {
     float c = 1.0f;
-    if (normal.attached() && frame.is_geometry(x, y) && frame.beside_background(x, y)) {
+    if (normal.attached() && beside[x - x0] && frame.is_geometry(x, y)) {
       const float* n = normal.pixel(x, y);
       const float length = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
       c = length < 1.0f ? length : 1.0f;  // NaN fails the test: 1
@@ -584,6 +586,7 @@ void Job::run() {
     const Tile t{output.x0 + dx, output.y0 + dy, output.x1 + dx, output.y1 + dy};
     ScratchVector<float> denoised(size_t(t.x1 - t.x0) * size_t(t.y1 - t.y0));
     ScratchVector<float> coverage(composite_out_.attached() ? size_t(t.x1 - t.x0) : 0);
+    ScratchVector<uint8_t> beside(coverage.size());
     const bool sky = !frame.has_geometry(t.x0, t.y0, t.x1, t.y1);
     // The visibility resolved at full resolution over `resolved` (the tile, or with the pixel
     // filter the tile and the pixels around it that the filter reads).
@@ -626,7 +629,8 @@ void Job::run() {
       if (!sky) geometry.add_row(depth, values, count);
       if (ao_out_.attached()) write_ao_row(values, count, ao_out_, t.x0 - dx, y - dy);
       if (composite_out_.attached()) {
-        coverage_row(frame, normal_, beauty_, t.x0, t.x1, y, dx, dy, coverage.data());
+        coverage_row(frame, normal_, beauty_, t.x0, t.x1, y, dx, dy, beside.data(),
+                     coverage.data());
         composite_row(values, coverage.data(), count, beauty_, ambient_, composite_out_, t.x0 - dx,
                       y - dy);
       }
