@@ -102,6 +102,8 @@ struct LaneProjection {
 // Frame::surface_normal of pixels x .. x + lanes - 1 of row y (the lanes past the row's end are
 // background: their normal is kept), from the frame's depth plane `depth` (width x height, at
 // least 3 x 3) and packed normals, their depth d, normal n and mixed-normal flags: (gx, gy, gz).
+// Most lanes' normals do not tilt across the surface: the first test costs a few operations per
+// stretch, on chords written with the middle pixel's ray (no positions).
 template <class VF, class M>
 HWY_INLINE void surface_normal_lanes(const LaneProjection<VF>& project, const float* depth,
                                      const uint32_t* normals, int width, int height, int x, int y,
@@ -113,64 +115,88 @@ HWY_INLINE void surface_normal_lanes(const LaneProjection<VF>& project, const fl
   const int lanes = int(hn::Lanes(df));
   gx = nx, gy = ny, gz = nz;
   // The stretches along the row and the column, centred on the pixel or, on the frame's border,
-  // on its neighbour: depths a, m, b of each and the pixels' columns and rows.
+  // on its neighbour: depths a, m, b of each, and the indices of their ends.
   const int cy = std::clamp(y, 1, height - 2);
   const VI column = hn::Iota(di, x);
   const VI cx = hn::Min(hn::Max(column, hn::Set(di, 1)), hn::Set(di, width - 2));
   const VI inside_column = hn::Min(column, hn::Set(di, width - 1));
+  const bool interior = x >= 1 && x + lanes <= width - 1 && y == cy;
+  const VI across_a = hn::Set(di, y * width) + cx - hn::Set(di, 1);
+  const VI down_a = hn::Set(di, (cy - 1) * width) + inside_column;
   VF ax_d, mx_d, bx_d, ay_d, my_d, by_d;
-  if (x >= 1 && x + lanes <= width - 1 && y == cy) {
+  if (interior) {
     const float* at = depth + size_t(y) * width + x;
     ax_d = hn::LoadU(df, at - 1), mx_d = d, bx_d = hn::LoadU(df, at + 1);
     ay_d = hn::LoadU(df, at - width), my_d = d, by_d = hn::LoadU(df, at + width);
   } else {
-    const VI row = hn::Set(di, y * width);
-    ax_d = hn::GatherIndex(df, depth, row + cx - hn::Set(di, 1));
-    mx_d = hn::GatherIndex(df, depth, row + cx);
-    bx_d = hn::GatherIndex(df, depth, row + cx + hn::Set(di, 1));
-    ay_d = hn::GatherIndex(df, depth, hn::Set(di, (cy - 1) * width) + inside_column);
-    my_d = hn::GatherIndex(df, depth, hn::Set(di, cy * width) + inside_column);
-    by_d = hn::GatherIndex(df, depth, hn::Set(di, (cy + 1) * width) + inside_column);
+    ax_d = hn::GatherIndex(df, depth, across_a);
+    mx_d = hn::GatherIndex(df, depth, across_a + hn::Set(di, 1));
+    bx_d = hn::GatherIndex(df, depth, across_a + hn::Set(di, 2));
+    ay_d = hn::GatherIndex(df, depth, down_a);
+    my_d = hn::GatherIndex(df, depth, down_a + hn::Set(di, width));
+    by_d = hn::GatherIndex(df, depth, down_a + hn::Set(di, 2 * width));
   }
   const VF one = hn::Set(df, 1.0f), zero = hn::Zero(df);
-  // CameraModel::view_position of pixel (qx, qy) at depth `at`.
-  const auto position = [&](VI qx, VI qy, VF at, VF& px, VF& py, VF& pz) {
-    project.pixel_ray(qx, qy, px, py);
-    const VF s = project.orthographic ? one : at;
-    px = px * s, py = py * s, pz = hn::Neg(at);
-  };
-  const VF reach =
-      hn::Set(df, Frame::kStretchFootprints) * project.scale_u * (project.orthographic ? one : d);
+  // Rays (pixel_ray) through the stretches' middle pixels; the ends' rays are one pixel's step
+  // to either side. A point is its ray times its depth at z = -depth (perspective) or its ray
+  // at z = -depth (orthographic): the differences below are written in rays and depths.
+  VF rx_across, ry_across, rx_down, ry_down;
+  project.pixel_ray(cx, hn::Set(di, y), rx_across, ry_across);
+  if (interior) {
+    rx_down = rx_across, ry_down = ry_across;
+  } else {
+    project.pixel_ray(inside_column, hn::Set(di, cy), rx_down, ry_down);
+  }
+  const bool ortho = project.orthographic;
+  const VF reach = hn::Set(df, Frame::kStretchFootprints) * project.scale_u * (ortho ? one : d);
   const VF reach2 = reach * reach;
-  // tilt_across in frame.cpp, in two parts: first whether n tilts across the chord a -> b (most
-  // lanes do not: nothing more is computed), then whether a -> m -> b is straight.
+  // tilt_across in frame.cpp, in two parts: first whether n tilts across the chord a -> b
+  // (most lanes do not: nothing more is computed), then whether a -> m -> b is straight.
   struct Stretch {
+    VF rx, ry, step_x, step_y;  // the middle's ray and the step to b's (a's is minus it)
+    VF a_d, m_d, b_d;
     VF chord_x, chord_y, chord_z, tilt, ab2, along;
     hn::Mask<decltype(df)> straight, tilts;
   };
-  const auto chord = [&](VI qa_x, VI qa_y, VF a_d, VI qb_x, VI qb_y, VF b_d) {
-    VF ax, ay, az, bx, by, bz;
-    position(qa_x, qa_y, a_d, ax, ay, az);
-    position(qb_x, qb_y, b_d, bx, by, bz);
+  const auto chord = [&](VF rx, VF ry, VF step_x, VF step_y, VF a_d, VF m_d, VF b_d) {
     Stretch s;
-    s.chord_x = bx - ax, s.chord_y = by - ay, s.chord_z = bz - az;
-    s.tilt = s.chord_x * nx + s.chord_y * ny + s.chord_z * nz;
-    s.ab2 = s.chord_x * s.chord_x + s.chord_y * s.chord_y + s.chord_z * s.chord_z;
-    s.tilts = hn::Gt(s.tilt * s.tilt, hn::Set(df, Frame::kSurfaceTiltSin2) * s.ab2);
+    s.rx = rx, s.ry = ry, s.step_x = step_x, s.step_y = step_y;
+    s.a_d = a_d, s.m_d = m_d, s.b_d = b_d;
+    // b - a: from a's ray (rx - step) by twice the step.
+    const VF delta = b_d - a_d;
+    const VF moved = ortho ? zero : delta, twice = ortho ? hn::Set(df, 2.0f) : b_d + a_d;
+    s.chord_x = hn::MulAdd(rx, moved, step_x * twice);
+    s.chord_y = hn::MulAdd(ry, moved, step_y * twice);
+    s.chord_z = hn::Neg(delta);
+    s.tilt = hn::MulAdd(s.chord_x, nx, hn::MulAdd(s.chord_y, ny, s.chord_z * nz));
+    s.ab2 =
+        hn::MulAdd(s.chord_x, s.chord_x, hn::MulAdd(s.chord_y, s.chord_y, s.chord_z * s.chord_z));
+    // A straight stretch's halves are shorter than the reach, so its chord shorter than twice it.
+    s.tilts = hn::And(hn::Gt(s.tilt * s.tilt, hn::Set(df, Frame::kSurfaceTiltSin2) * s.ab2),
+                      hn::Lt(s.ab2, hn::Set(df, 4.0f) * reach2));
     return s;
   };
-  const VI row_y = hn::Set(di, y), row_cy = hn::Set(di, cy);
-  Stretch across = chord(cx - hn::Set(di, 1), row_y, ax_d, cx + hn::Set(di, 1), row_y, bx_d);
-  Stretch down =
-      chord(inside_column, hn::Set(di, cy - 1), ay_d, inside_column, hn::Set(di, cy + 1), by_d);
+  Stretch across = chord(rx_across, ry_across, project.scale_u, zero, ax_d, mx_d, bx_d);
+  Stretch down = chord(rx_down, ry_down, zero, hn::Neg(project.scale_v), ay_d, my_d, by_d);
   const auto candidate = hn::AndNot(mixed, hn::Or(across.tilts, down.tilts));
   if (hn::AllFalse(df, candidate)) return;
-  const auto straight = [&](Stretch& s, VI qa_x, VI qa_y, VF a_d, VI qm_x, VI qm_y, VF m_d, VI qb_x,
-                            VI qb_y) {
-    VF ax, ay, az, mx, my, mz;
-    position(qa_x, qa_y, a_d, ax, ay, az);
-    position(qm_x, qm_y, m_d, mx, my, mz);
-    const VF max_ = mx - ax, may = my - ay, maz = mz - az;                          // m - a
+  const int32_t* packed = reinterpret_cast<const int32_t*>(normals);
+  // The ends' packed normals: in the frame's interior, contiguous from the first lane's a (at a
+  // pixel's index `first_a`, only valid there).
+  const auto end_normals = [&](VI a_index, int b_offset, size_t first_a, VI& na, VI& nb) {
+    if (interior) {
+      na = hn::LoadU(di, packed + first_a), nb = hn::LoadU(di, packed + first_a + b_offset);
+    } else {
+      na = hn::GatherIndex(di, packed, a_index);
+      nb = hn::GatherIndex(di, packed, a_index + hn::Set(di, b_offset));
+    }
+  };
+  const auto straight = [&](Stretch& s, VI a_index, int b_offset, size_t first_a) {
+    // m - a: a's ray is rx - step, m's rx.
+    const VF delta = s.m_d - s.a_d;
+    const VF moved = ortho ? zero : delta, base = ortho ? one : s.a_d;
+    const VF max_ = hn::MulAdd(s.rx, moved, s.step_x * base);
+    const VF may = hn::MulAdd(s.ry, moved, s.step_y * base), maz = hn::Neg(delta);
     const VF bmx = s.chord_x - max_, bmy = s.chord_y - may, bmz = s.chord_z - maz;  // b - m
     const VF la2 = max_ * max_ + may * may + maz * maz, lb2 = bmx * bmx + bmy * bmy + bmz * bmz;
     const VF turn = max_ * bmx + may * bmy + maz * bmz;
@@ -180,20 +206,20 @@ HWY_INLINE void surface_normal_lanes(const LaneProjection<VF>& project, const fl
                         hn::Gt(turn * turn, hn::Set(df, Frame::kStraightCos2) * la2 * lb2)),
                 hn::And(hn::Lt(longer, hn::Set(df, 4.0f) * shorter), hn::Lt(longer, reach2)));
     // The normals at both ends agree: the slow turn of interpolated vertex normals, not a bump.
+    VI na, nb;
+    end_normals(a_index, b_offset, first_a, na, nb);
     VF anx, any, anz, bnx, bny, bnz;
-    const int32_t* packed = reinterpret_cast<const int32_t*>(normals);
-    const VI w = hn::Set(di, width);
-    decode_normals(df, hn::GatherIndex(di, packed, qa_y * w + qa_x), anx, any, anz);
-    decode_normals(df, hn::GatherIndex(di, packed, qb_y * w + qb_x), bnx, bny, bnz);
+    decode_normals(df, na, anx, any, anz);
+    decode_normals(df, nb, bnx, bny, bnz);
     const auto agree =
         hn::Gt(anx * bnx + any * bny + anz * bnz, hn::Set(df, Frame::kSmoothNormalsCos));
     s.tilts = hn::And(hn::And(s.straight, s.tilts), agree);
     s.along = hn::IfThenElseZero(s.tilts, s.tilt / hn::IfThenElse(s.tilts, s.ab2, one));
   };
-  straight(across, cx - hn::Set(di, 1), row_y, ax_d, cx, row_y, mx_d, cx + hn::Set(di, 1), row_y);
-  straight(down, inside_column, hn::Set(di, cy - 1), ay_d, inside_column, row_cy, my_d,
-           inside_column, hn::Set(di, cy + 1));
-  const auto tilted = hn::AndNot(mixed, hn::Or(across.tilts, down.tilts));
+  const size_t at = size_t(y) * width + x;
+  straight(across, across_a, 2, at - 1);
+  straight(down, down_a, 2 * width, at - width);
+  const auto tilted = hn::And(candidate, hn::Or(across.tilts, down.tilts));
   if (hn::AllFalse(df, tilted)) return;
   VF tx = nx - across.chord_x * across.along - down.chord_x * down.along;
   VF ty = ny - across.chord_y * across.along - down.chord_y * down.along;
