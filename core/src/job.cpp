@@ -147,6 +147,25 @@ void write_ao_row(const float* ao, int count, const ImageView& out, int x, int y
   }
 }
 
+// What the composite multiplies a pixel's colour by: AO itself where the surface covers the
+// pixel (1 - (1 - AO) need not round back to AO), else 1 - c (1 - AO).
+inline float composite_factor(float ao, float coverage) {
+  return coverage < 1.0f ? 1.0f - coverage * (1.0f - ao) : ao;
+}
+
+// composite_row's plain case on packed RGB or RGBA pixels (alpha copied): a loop the compiler
+// vectorises, where the general one's channel count and strides are known only at run time.
+// src and dst may be the same pixels (a composite in place): no __restrict on them.
+template <int kChannels>
+SSAO_VECTORIZE void composite_packed(const float* __restrict ao, const float* __restrict coverage,
+                                     int count, const float* src, float* dst) {
+  for (int i = 0; i < count; ++i) {
+    const float factor = composite_factor(ao[i], coverage[i]);
+    for (int c = 0; c < 3; ++c) dst[i * kChannels + c] = src[i * kChannels + c] * factor;
+    if (kChannels == 4) dst[i * kChannels + 3] = src[i * kChannels + 3];
+  }
+}
+
 // The composite of pixels [x, x + count) of row y: the beauty darkened on the share c of each
 // pixel that the surface covers, beauty x (1 - c (1 - AO)), or, with an ambient image, the beauty
 // less c (1 - AO) of the ambient light (never below 0 where the beauty is not). Colour channels
@@ -171,11 +190,16 @@ void composite_row(const float* ao, const float* coverage, int count, const Imag
     }
     return;
   }
-  for (int i = 0; i < count; ++i, src += src_step, dst += dst_step) {
-    // AO itself where the pixel is covered: 1 - (1 - AO) need not round back to AO.
-    const float factor = coverage[i] < 1.0f ? 1.0f - coverage[i] * (1.0f - ao[i]) : ao[i];
-    for (int c = 0; c < colour; ++c) dst[c] = src[c] * factor;
-    for (int c = colour; c < channels; ++c) dst[c] = src[c];
+  if (src_step == channels && dst_step == channels && channels == 3) {
+    composite_packed<3>(ao, coverage, count, src, dst);
+  } else if (src_step == channels && dst_step == channels && channels == 4) {
+    composite_packed<4>(ao, coverage, count, src, dst);
+  } else {
+    for (int i = 0; i < count; ++i, src += src_step, dst += dst_step) {
+      const float factor = composite_factor(ao[i], coverage[i]);
+      for (int c = 0; c < colour; ++c) dst[c] = src[c] * factor;
+      for (int c = colour; c < channels; ++c) dst[c] = src[c];
+    }
   }
 }
 
