@@ -2,9 +2,14 @@
 // Internals against independent references: the camera model against Blender's own projection
 // matrices, the variants against the brute-force ray march (tests/reference) on analytic
 // scenes, and each variant's vectorised path against its scalar reference.
+#include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <cstring>
+#include <limits>
+#include <utility>
+#include <vector>
 
 #include "analytic_scene.h"
 #include "camera.h"
@@ -421,6 +426,53 @@ TEST(Frame, LastThicknessIsMeasuredBesideTheForeground) {
         facing ? "given" : "alternating", slab, measured, exact);
     EXPECT_GT(measured, slab / 2);
     EXPECT_GE(exact, measured * 9 / 10);
+  }
+}
+
+TEST(Frame, BesideBackgroundRowMatchesTheNeighboursOneByOne) {
+  // Sky scattered over frames from 1x1 up, every row asked whole and in windows that start and
+  // end at the frame's borders and inside it: each flag must say whether one of the (up to 8)
+  // pixels around is sky, as a walk over the neighbours says.
+  uint32_t seed = 12345;
+  const auto random = [&] {
+    seed = seed * 1664525u + 1013904223u;
+    return float(seed >> 8) / float(1u << 24);
+  };
+  for (const auto& size : {std::pair{1, 1}, {2, 3}, {3, 2}, {7, 5}, {40, 6}}) {
+    Camera c;
+    c.width = size.first, c.height = size.second;
+    const int w = c.width, h = c.height;
+    std::vector<float> depth(size_t(w) * h);
+    for (float& d : depth) d = random() < 0.15f ? std::numeric_limits<float>::infinity() : 2.0f;
+    ssao::FrameInputs in;
+    in.depth = ssao::ImageView{depth.data(), w, h, 1, 4, 4 * std::ptrdiff_t(w)};
+    ssao::TilePool pool(1);
+    ssao::Progress progress(nullptr, nullptr);
+    ssao::Frame f;
+    f.reset(camera_model(c, w, h), w, h, 0);
+    f.build(in, pool, progress);
+    size_t beside_count = 0;
+    for (int y = 0; y < h; ++y) {
+      for (const auto& window : {std::pair{0, w}, {0, w / 2}, {w / 2, w}, {1, w - 1}}) {
+        const int x0 = window.first, x1 = window.second;
+        if (x1 <= x0) continue;
+        std::vector<uint8_t> beside(size_t(x1 - x0), 7);
+        f.beside_background_row(y, x0, x1, beside.data());
+        for (int x = x0; x < x1; ++x) {
+          bool expected = false;
+          for (int ny = std::max(y - 1, 0); ny <= std::min(y + 1, h - 1); ++ny) {
+            for (int nx = std::max(x - 1, 0); nx <= std::min(x + 1, w - 1); ++nx) {
+              expected = expected || !f.is_geometry(nx, ny);
+            }
+          }
+          EXPECT_EQ(beside[x - x0], expected ? 1 : 0) << w << "x" << h << " at " << x << ", " << y;
+          beside_count += expected ? 1 : 0;
+        }
+      }
+    }
+    if (w * h > 20) {
+      EXPECT_GT(beside_count, 0u) << w << "x" << h;  // the sky is there
+    }
   }
 }
 
