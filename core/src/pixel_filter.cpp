@@ -3,6 +3,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <cstring>
 
 #include "scratch.h"
 #include "simd.h"
@@ -122,6 +124,28 @@ SSAO_VECTORIZE void jump_row(const float* __restrict depth, const float* __restr
   }
 }
 
+// The pixels of a row that may lie on an edge: 1 where the pixel's own flag (own[i], jump_row's),
+// its left neighbour's (own[i - 1], for i >= 1) or its upper neighbour's (above[i]) is set. A
+// plain loop the compiler vectorises, so that the caller skips the rest a word at a time.
+SSAO_VECTORIZE void edge_candidate_row(const unsigned char* __restrict own,
+                                       const unsigned char* __restrict above, int count,
+                                       unsigned char* __restrict candidates) {
+  for (int i = 0; i < count; ++i) candidates[i] = static_cast<unsigned char>(own[i] | above[i]);
+  for (int i = 1; i < count; ++i) candidates[i] |= own[i - 1];
+}
+
+// The first index from i on (below count) whose byte is set, else count: eight at a time over
+// the zeros.
+int next_set(const unsigned char* bytes, int i, int count) {
+  for (; i + 8 <= count; i += 8) {
+    uint64_t word;
+    std::memcpy(&word, bytes + i, sizeof word);
+    if (word != 0) break;
+  }
+  while (i < count && bytes[i] == 0) ++i;
+  return i;
+}
+
 // Where point m lies along the line from b to a: `share` such that b + share (a - b) is its
 // nearest point. True if m lies within tolerance x |a - b| of that line (false for a == b, NaN).
 bool share_on_line(const Vec3& m, const Vec3& a, const Vec3& b, float tolerance, float& share) {
@@ -224,13 +248,18 @@ void mix_edges_by_beauty(const Frame& frame, const ImageView& beauty, const Imag
       out_flags[columns - 1] = depth_jump(row[columns - 1], below[columns - 1]) ? 1 : 0;
     }
   }
-  const auto flagged = [&](int x, int y) {
-    return x >= x_first && y >= y_first &&
-           flags[size_t(y - y_first) * size_t(columns) + size_t(x - x_first)] != 0;
-  };
+  // The candidates, a row at a time (none outside the flags' rows and columns).
+  ScratchVector<unsigned char> candidates(static_cast<size_t>(width));
+  const int left_column = t.x0 - x_first;  // 1 where column t.x0 - 1 has flags, else 0
   for (int y = t.y0; y < t.y1; ++y) {
-    for (int x = t.x0; x < t.x1; ++x) {
-      if (!flagged(x, y) && !flagged(x - 1, y) && !flagged(x, y - 1)) continue;
+    const unsigned char* row_flags =
+        flags.data() + size_t(y - y_first) * size_t(columns) + left_column;
+    const unsigned char* above_flags = y > y_first ? row_flags - columns : row_flags;
+    edge_candidate_row(row_flags, above_flags, width, candidates.data());
+    if (left_column == 1) candidates[0] |= row_flags[-1];
+    for (int i = next_set(candidates.data(), 0, width); i < width;
+         i = next_set(candidates.data(), i + 1, width)) {
+      const int x = t.x0 + i;
       if (!frame.is_geometry(x, y)) continue;
       const float depth = frame.depth(x, y);
       // The neighbour across the largest jump.
