@@ -154,20 +154,23 @@ HWY_INLINE void surface_normal_lanes(const LaneProjection<VF>& project, const fl
   // (most lanes do not: nothing more is computed), then whether a -> m -> b is straight.
   struct Stretch {
     VF rx, ry, step_x, step_y;  // the middle's ray and the step to b's (a's is minus it)
-    VF a_d, m_d, b_d;
+    VF a_d, m_d;
     VF chord_x, chord_y, chord_z, tilt, ab2, along;
     hn::Mask<decltype(df)> straight, tilts;
+  };
+  // q - a for a point q whose depth is `delta` more than a's: rx delta + step base, where `base`
+  // (a's depth plus q's, or a's) and the ortho base (2 or 1) count the steps from a's ray.
+  const auto from_a = [&](const Stretch& s, VF delta, VF base, VF& ox, VF& oy, VF& oz) {
+    const VF moved = ortho ? zero : delta;
+    ox = hn::MulAdd(s.rx, moved, s.step_x * base), oy = hn::MulAdd(s.ry, moved, s.step_y * base);
+    oz = hn::Neg(delta);
   };
   const auto chord = [&](VF rx, VF ry, VF step_x, VF step_y, VF a_d, VF m_d, VF b_d) {
     Stretch s;
     s.rx = rx, s.ry = ry, s.step_x = step_x, s.step_y = step_y;
-    s.a_d = a_d, s.m_d = m_d, s.b_d = b_d;
-    // b - a: from a's ray (rx - step) by twice the step.
-    const VF delta = b_d - a_d;
-    const VF moved = ortho ? zero : delta, twice = ortho ? hn::Set(df, 2.0f) : b_d + a_d;
-    s.chord_x = hn::MulAdd(rx, moved, step_x * twice);
-    s.chord_y = hn::MulAdd(ry, moved, step_y * twice);
-    s.chord_z = hn::Neg(delta);
+    s.a_d = a_d, s.m_d = m_d;
+    // b - a: b's ray is twice the step from a's (rx - step).
+    from_a(s, b_d - a_d, ortho ? hn::Set(df, 2.0f) : b_d + a_d, s.chord_x, s.chord_y, s.chord_z);
     s.tilt = hn::MulAdd(s.chord_x, nx, hn::MulAdd(s.chord_y, ny, s.chord_z * nz));
     s.ab2 =
         hn::MulAdd(s.chord_x, s.chord_x, hn::MulAdd(s.chord_y, s.chord_y, s.chord_z * s.chord_z));
@@ -192,11 +195,9 @@ HWY_INLINE void surface_normal_lanes(const LaneProjection<VF>& project, const fl
     }
   };
   const auto straight = [&](Stretch& s, VI a_index, int b_offset, size_t first_a) {
-    // m - a: a's ray is rx - step, m's rx.
-    const VF delta = s.m_d - s.a_d;
-    const VF moved = ortho ? zero : delta, base = ortho ? one : s.a_d;
-    const VF max_ = hn::MulAdd(s.rx, moved, s.step_x * base);
-    const VF may = hn::MulAdd(s.ry, moved, s.step_y * base), maz = hn::Neg(delta);
+    // m - a: m's ray is one step from a's.
+    VF max_, may, maz;
+    from_a(s, s.m_d - s.a_d, ortho ? one : s.a_d, max_, may, maz);
     const VF bmx = s.chord_x - max_, bmy = s.chord_y - may, bmz = s.chord_z - maz;  // b - m
     const VF la2 = max_ * max_ + may * may + maz * maz, lb2 = bmx * bmx + bmy * bmy + bmz * bmz;
     const VF turn = max_ * bmx + may * bmy + maz * bmz;
