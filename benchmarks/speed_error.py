@@ -640,7 +640,9 @@ def write_markdown(path, images, args, plan, rows, table, complexity, noise, mac
         % (ground_truth(plan), plan.noise_scene,
            ", ".join("%.4f at %s (%d pixels)" % entry for entry in noise)),
         "Times are medians of %d interleaved run(s) of the AO computation alone (libssao "
-        "through the C API, %d threads; the seed ports on one thread) and of the Cycles "
+        "through the C API, %d threads; the seed ports on one thread; each timed run right "
+        "after an untimed run of the same method, so that none pays for the one before it) "
+        "and of the Cycles "
         "render call (scene sync, BVH build and sampling; %d threads). A Cycles row with "
         "`samples=N` is its AO pass rendered the fastest correct way at N samples per pixel."
         % (plan.repeat, args.threads, args.threads),

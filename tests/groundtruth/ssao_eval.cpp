@@ -68,7 +68,8 @@ const char* const kUsage =
     "over the pixels whose depth is finite, > 0 and < 0.9 * clip_end (the geometry pixels).\n"
     "mean_error is the mean of (method - truth): positive means too little occlusion. time_ms\n"
     "is the median of --repeat runs of the AO computation alone (no file I/O), min_ms the\n"
-    "fastest; the methods run in interleaved rounds (A B C A B C ...) after one untimed round.\n"
+    "fastest; the methods run in interleaved rounds (A B C A B C ...) after one untimed round,\n"
+    "each timed run right after an untimed run of the same method.\n"
     "An image method is not timed (nan). rmse_interior leaves out the pixels beside one outside\n"
     "that set: on a silhouette against the sky Cycles' pass reads coverage x AO (sky samples\n"
     "add nothing).\n"
@@ -858,7 +859,10 @@ Method make_method(const std::string& name, const std::vector<Setting>& settings
 }
 
 // Wall times in milliseconds of `repeat` runs of every timed method, in interleaved rounds,
-// after one untimed round (first-touch page faults, thread start-up).
+// after one untimed round (first-touch page faults, thread start-up). Each timed run follows an
+// untimed run of the same method: the first run with two threads after a method on one thread
+// (the seed ports) took 1.6x as long on this 2-core VM (the idle core waking), which made the
+// default, first in each round, look slower than `resolution=half`, the same settings.
 std::vector<std::vector<double>> time_interleaved(const std::vector<Method>& methods, int repeat) {
   std::vector<std::vector<double>> times(methods.size());
   for (const Method& m : methods) {
@@ -867,6 +871,7 @@ std::vector<std::vector<double>> time_interleaved(const std::vector<Method>& met
   for (int round = 0; round < repeat; ++round) {
     for (size_t i = 0; i < methods.size(); ++i) {
       if (!methods[i].run) continue;
+      methods[i].run();  // untimed: the same state for every method (see above)
       const auto start = std::chrono::steady_clock::now();
       methods[i].run();
       const auto stop = std::chrono::steady_clock::now();
