@@ -253,6 +253,118 @@ HWY_INLINE VF between_lanes(const HemisphereRowArgs& a, const LaneProjection<VF>
   return hn::IfThenElseZero(inside, covered * hn::IfThenElse(hn::Lt(next, zero), one, thick));
 }
 
+// Frame::solid_entry on the lanes of `hidden`, points at planar depth `depth` behind the visible
+// surface (depth qd) of the pixels at `index`: walks the hits behind the visible one until the one
+// the point lies in front of. `entry`: the depth of the front face the point lies behind;
+// `entered`: it lies behind a front face at all; `closed`: a back face follows it on the ray.
+// Returns how much that solid occludes the point: 1 inside a solid a back face closes, else by
+// the solid's thickness (measured beside the foreground for the ray's last hit,
+// Frame::last_thickness, else assumed).
+template <class M, class VF, class VI>
+HWY_INLINE VF solid_weight_lanes(const HemisphereRowArgs& a, VI index, M hidden, VF qd, VF depth,
+                                 VF& entry, M& entered, M& closed) {
+  namespace hn = hwy::HWY_NAMESPACE;
+  const hn::DFromV<VF> df;
+  const VF zero = hn::Zero(df), one = hn::Set(df, 1.0f);
+  const VF inf = hn::Set(df, std::numeric_limits<float>::infinity());
+  const VF inv_thickness = hn::Set(df, 1.0f / a.thickness);
+  const auto none = hn::Lt(one, zero);
+  entry = qd;
+  entered = hidden;    // the visible surface is a front face
+  auto open = hidden;  // not yet placed between two hits
+  closed = none;
+  auto past_last = none;  // behind the last hit the ray knows
+  for (int layer = 0; layer < a.extra_layers; ++layer) {
+    const VF hit = hn::GatherIndex(df, a.layers + size_t(layer) * a.plane, index);
+    const VF hit_depth = hn::Abs(hit);
+    const auto back = hn::Lt(hit, zero);
+    const auto here = hn::And(open, hn::Le(depth, hit_depth));
+    closed = hn::Or(closed, hn::And(here, hn::And(entered, back)));
+    past_last = hn::Or(past_last, hn::And(here, hn::Eq(hit, inf)));
+    const auto past = hn::AndNot(here, open);  // open lanes behind this hit
+    entry = hn::IfThenElse(past, hit_depth, entry);
+    entered = hn::Or(hn::AndNot(past, entered), hn::AndNot(back, past));
+    open = past;
+    if (hn::AllFalse(df, open)) break;
+  }
+  past_last = hn::Or(past_last, open);
+  // Behind the last known hit, a front face: the solid's thickness where the frame measured it
+  // beside the foreground, else the assumed one.
+  VF inv_depth_of_solid = inv_thickness;
+  const auto measured_lanes = hn::And(hn::And(past_last, entered), hn::AndNot(closed, hidden));
+  if (!hn::AllFalse(df, measured_lanes)) {
+    const VF measured = hn::GatherIndex(df, a.last_thickness, index);
+    const auto known = hn::And(measured_lanes, hn::Gt(measured, zero));
+    inv_depth_of_solid =
+        hn::IfThenElse(known, one / hn::IfThenElse(known, measured, one), inv_thickness);
+  }
+  const VF thick =
+      hn::Min(one, hn::Max(zero, hn::Set(df, 2.0f) - (depth - entry) * inv_depth_of_solid));
+  return hn::IfThenElse(closed, one, thick);
+}
+
+// Hemisphere::beyond_frame on the lanes of `outside`, samples (sx, sy, sz) in front of the camera
+// whose image coordinates (su, sv) fall outside the frame: the weight with which the surface of
+// the nearest pixel on the frame's border, carried on beyond it as its tangent plane, occludes
+// them (0 where it does not).
+template <class M, class VF>
+HWY_INLINE VF beyond_frame_lanes(const HemisphereRowArgs& a, const LaneProjection<VF>& project,
+                                 M outside, VF su, VF sv, VF sx, VF sy, VF sz, VF gx, VF gy, VF gz,
+                                 VF plane_level) {
+  namespace hn = hwy::HWY_NAMESPACE;
+  const hn::DFromV<VF> df;
+  const hn::RebindToSigned<decltype(df)> di;
+  const VF zero = hn::Zero(df), one = hn::Set(df, 1.0f);
+  // The nearest border pixel (NaN coordinates, from a sample at the camera's plane, go to 0).
+  const VF u = hn::Min(hn::Max(hn::IfThenElseZero(hn::And(outside, hn::Eq(su, su)), su), zero),
+                       hn::Set(df, float(a.width - 1)));
+  const VF v = hn::Min(hn::Max(hn::IfThenElseZero(hn::And(outside, hn::Eq(sv, sv)), sv), zero),
+                       hn::Set(df, float(a.height - 1)));
+  const auto qx = hn::ConvertTo(di, u), qy = hn::ConvertTo(di, v);
+  const auto index = qy * hn::Set(di, a.width) + qx;
+  const VF qd = hn::GatherIndex(df, a.depth, index);
+  auto counts = hn::And(outside, hn::Lt(qd, hn::Set(df, std::numeric_limits<float>::infinity())));
+  if (hn::AllFalse(df, counts)) return zero;
+  // Its surface's plane dot(x, n) = w (n of any length).
+  VF ray_x, ray_y;
+  project.pixel_ray(qx, qy, ray_x, ray_y);
+  const VF q_scale = a.camera.orthographic ? one : qd;
+  VF nx, ny, nz;
+  decode_directions(df, hn::GatherIndex(di, reinterpret_cast<const int32_t*>(a.normals), index), nx,
+                    ny, nz);
+  const VF w = hn::MulAdd(ray_x * q_scale, nx, hn::MulAdd(ray_y * q_scale, ny, hn::Neg(qd) * nz));
+  // Where the sample's ray meets it: t x the sample (perspective), or the sample moved along z
+  // (orthographic); `ahead`: how far that point lies in front of the sample.
+  VF ex, ey, ez;
+  if (a.camera.orthographic) {
+    counts = hn::And(counts, hn::Gt(hn::Abs(nz), hn::Set(df, 1e-6f)));
+    ex = sx, ey = sy;
+    ez = (w - hn::MulAdd(sx, nx, sy * ny)) / hn::IfThenElse(counts, nz, one);
+  } else {
+    const VF along = hn::MulAdd(sx, nx, hn::MulAdd(sy, ny, sz * nz));
+    counts = hn::And(counts, hn::Gt(hn::Abs(along), hn::Set(df, 1e-12f)));
+    const VF span = hn::IfThenElse(counts, along, one);
+    const VF estimate = hn::ApproximateReciprocal(span);  // refined by a Newton step
+    const VF t = w * (estimate * hn::NegMulAdd(span, estimate, hn::Set(df, 2.0f)));
+    counts = hn::And(counts, hn::Gt(t, zero));
+    ex = t * sx, ey = t * sy, ez = t * sz;
+  }
+  const VF ahead = ez - sz;
+  const VF level = hn::MulAdd(ex, gx, hn::MulAdd(ey, gy, ez * gz));
+  counts = hn::And(counts, hn::And(hn::Gt(ahead, zero), hn::Gt(level, plane_level)));
+  VF weight = hn::Min(
+      one, hn::Max(zero, hn::NegMulAdd(ahead, hn::Set(df, 1.0f / a.thickness), hn::Set(df, 2.0f))));
+  if (a.extra_layers > 0 && !hn::AllFalse(df, counts)) {
+    // The border pixel's hits go on beyond the frame too: the sample, `ahead` behind the plane,
+    // stands where a point that far behind the border pixel's visible surface stands among them.
+    VF entry;
+    auto entered = counts, closed = counts;
+    const VF solid = solid_weight_lanes(a, index, counts, qd, qd + ahead, entry, entered, closed);
+    weight = hn::IfThenElseZero(entered, solid);
+  }
+  return hn::IfThenElseZero(counts, weight);
+}
+
 // Visibility of pixels [x0, x1) of row y into out[0 .. x1 - x0); kLayers: the frame has extra
 // depth layers (compiled apart, so that the one-layer loop carries none of their state).
 template <bool kLayers>
@@ -362,7 +474,15 @@ HWY_NOINLINE void hemisphere_row_of(const HemisphereRowArgs& a, int y, int x0, i
         const VF sz = hn::MulAdd(tz, ox, hn::MulAdd(bz, oy, hn::MulAdd(nz, oz, pz)));
         VF su, sv;
         const auto in_image = hn::And(project(sx, sy, sz, su, sv), receiver);
-        seen = hn::Or(seen, in_image);
+        // A sample whose pixel lies outside the frame, in front of the camera, meets the surfaces
+        // at the frame's border carried on beyond it (Hemisphere::beyond_frame).
+        const auto in_front = cam.orthographic ? receiver : hn::And(receiver, hn::Lt(sz, zero));
+        const auto outside = hn::AndNot(in_image, in_front);
+        if (!hn::AllFalse(df, outside)) {
+          blocked = hn::Max(blocked, beyond_frame_lanes(a, project, outside, su, sv, sx, sy, sz, gx,
+                                                        gy, gz, plane_level));
+        }
+        seen = hn::Or(seen, in_front);
         if constexpr (!kLayers) {
           if (hn::AllFalse(df, in_image)) continue;
           const VI qx = hn::ConvertTo(di, hn::IfThenElseZero(in_image, su));
@@ -427,51 +547,18 @@ HWY_NOINLINE void hemisphere_row_of(const HemisphereRowArgs& a, int y, int x0, i
               blocked = hn::Max(blocked, hn::IfThenElseZero(hn::AndNot(hidden, above), covered));
             }
             if (!hn::AllFalse(df, hidden)) {
-              // Frame::solid_entry on the lanes: walk the hits behind the visible one until the
-              // one the sample lies in front of.
-              const VF sample_depth = hn::Neg(sz);
-              VF entry = qd;
-              auto entered = hidden;  // the visible surface is a front face
-              auto open = hidden;     // not yet placed between two hits
-              auto closed = none;
-              auto past_last = none;  // behind the last hit the ray knows
-              for (int layer = 0; layer < a.extra_layers; ++layer) {
-                const VF hit = hn::GatherIndex(df, a.layers + size_t(layer) * a.plane, index);
-                const VF hit_depth = hn::Abs(hit);
-                const auto back = hn::Lt(hit, zero);
-                const auto here = hn::And(open, hn::Le(sample_depth, hit_depth));
-                closed = hn::Or(closed, hn::And(here, hn::And(entered, back)));
-                past_last = hn::Or(past_last, hn::And(here, hn::Eq(hit, inf)));
-                const auto past = hn::AndNot(here, open);  // open lanes behind this hit
-                entry = hn::IfThenElse(past, hit_depth, entry);
-                entered = hn::Or(hn::AndNot(past, entered), hn::AndNot(back, past));
-                open = past;
-                if (hn::AllFalse(df, open)) break;
-              }
-              past_last = hn::Or(past_last, open);
-              // Behind the last known hit, a front face: the solid's thickness where the frame
-              // measured it beside the foreground (Frame::last_thickness), else the assumed one.
-              VF inv_depth_of_solid = inv_thickness;
-              const auto measured_lanes =
-                  hn::And(hn::And(past_last, entered), hn::AndNot(closed, hidden));
-              if (!hn::AllFalse(df, measured_lanes)) {
-                const VF measured = hn::GatherIndex(df, a.last_thickness, index);
-                const auto known = hn::And(measured_lanes, hn::Gt(measured, zero));
-                inv_depth_of_solid = hn::IfThenElse(
-                    known, one / hn::IfThenElse(known, measured, one), inv_thickness);
-              }
-              // Occluded by the solid entered at `entry` (inside it when a back face closes it,
-              // else within the assumed thickness), when that surface is above the tangent
+              VF entry;
+              auto entered = hidden, closed = none;
+              const VF solid =
+                  solid_weight_lanes(a, index, hidden, qd, hn::Neg(sz), entry, entered, closed);
+              // Occluded by the solid entered at `entry`, when that surface is above the tangent
               // plane.
               const VF entry_scale = cam.orthographic ? one : entry;
               const VF ex = ray_x * entry_scale, ey = ray_y * entry_scale;
               const VF entry_level = hn::MulAdd(ex, gx, hn::MulAdd(ey, gy, hn::Neg(entry) * gz));
               const auto counts =
                   hn::And(hn::And(hidden, entered), hn::Gt(entry_level, plane_level));
-              const VF thick =
-                  hn::Min(one, hn::Max(zero, two - (sample_depth - entry) * inv_depth_of_solid));
-              const VF weight = hn::IfThenElse(hn::Eq(entry, qd), covered, one) *
-                                hn::IfThenElse(closed, one, thick);
+              const VF weight = hn::IfThenElse(hn::Eq(entry, qd), covered, one) * solid;
               blocked = hn::Max(blocked, hn::IfThenElseZero(counts, weight));
             }
           }
@@ -726,7 +813,11 @@ class Hemisphere final : public Variant {
         int qx = -1, qy = -1;
         bool hidden = false, above = false;
         Vec3 surface{}, surface_normal{};
-        if (pixel_of_sample(f, sample, qx, qy)) {
+        const bool in_front = f.camera().intrinsics().orthographic || sample.z < 0.0f;
+        if (!pixel_of_sample(f, sample, qx, qy) && in_front) {
+          seen = true;
+          blocked = std::max(blocked, beyond_frame(f, geometric_normal, min_height, p, sample));
+        } else if (in_front) {
           seen = true;
           if (f.is_geometry(qx, qy)) {
             surface = f.position(qx, qy);
@@ -784,6 +875,46 @@ class Hemisphere final : public Variant {
       occlusion += blocked;
     }
     return valid > 0 ? 1.0f - occlusion / float(valid) : 1.0f;
+  }
+
+  // A sample in front of the camera whose pixel lies outside the frame: nothing in the images
+  // says what it meets, so the surfaces at the frame's border are taken to go on beyond it, each
+  // as its tangent plane (a floor or a wall cut by the frame's edge: what a guard band would
+  // show). The plane of the nearest border pixel's surface, where the sample's ray meets it,
+  // stands for the visible surface; it occludes within the assumed thickness when above the
+  // receiver's tangent plane (normal g, through p); with extra layers, the border pixel's hits
+  // say how deep its solids are. Returns the sample's weight, 0 if none.
+  float beyond_frame(const Frame& f, Vec3 g, float min_height, Vec3 p, Vec3 sample) const {
+    float u = 0.0f, v = 0.0f;
+    f.camera().project(sample, u, v);
+    // NaN (a sample at the camera's plane) goes to 0, as on the vector path.
+    const int qx = int(std::min(std::max(u >= 0.0f ? u : 0.0f, 0.0f), float(f.width() - 1)));
+    const int qy = int(std::min(std::max(v >= 0.0f ? v : 0.0f, 0.0f), float(f.height() - 1)));
+    if (!f.is_geometry(qx, qy)) return 0.0f;
+    const Vec3 q = f.position(qx, qy), n = f.normal(qx, qy);
+    const float w = dot(q, n);
+    Vec3 meets;
+    if (f.camera().intrinsics().orthographic) {
+      if (!(std::fabs(n.z) > 1e-6f)) return 0.0f;
+      meets = {sample.x, sample.y, (w - sample.x * n.x - sample.y * n.y) / n.z};
+    } else {
+      const float along = dot(sample, n);
+      if (!(std::fabs(along) > 1e-12f)) return 0.0f;
+      const float t = w / along;
+      if (!(t > 0.0f)) return 0.0f;
+      meets = sample * t;
+    }
+    const float ahead = meets.z - sample.z;
+    if (!(ahead > 0.0f) || !(dot(meets - p, g) > min_height)) return 0.0f;
+    if (f.extra_layers() == 0) return thickness_weight(ahead, thickness_);
+    // The border pixel's hits go on beyond the frame too: the sample, `ahead` behind the plane,
+    // stands where a point that far behind the border pixel's visible surface stands among them.
+    const float depth = f.depth(qx, qy) + ahead;
+    bool closed = false, past_last = false;
+    const float entry = f.solid_entry(qx, qy, depth, closed, &past_last);
+    if (entry == Frame::kBackground) return 0.0f;
+    const float measured = past_last ? f.last_thickness(qx, qy) : 0.0f;
+    return closed ? 1.0f : thickness_weight(depth - entry, measured > 0.0f ? measured : thickness_);
   }
 
   static bool sides_differ(Vec3 a, Vec3 b, Vec3 q, Vec3 nq) {
