@@ -395,11 +395,16 @@ class AddonTest(unittest.TestCase):
                 np.testing.assert_allclose(node, cli, rtol=0, atol=1e-6)
 
     def test_hidden_surfaces_and_overscan_bring_the_ao_closer_to_cycles(self):
-        # The node's helper render (hidden_surfaces.py): the 2nd to 5th surface hits and a
-        # guard band must bring the node's AO closer to Cycles' AO pass of the same render.
-        # Measured at 160x90, 128 spp: RMSE 0.0771 without, 0.0633 with the layers, 0.0555 with
-        # a 16 px band, 0.0381 with both (3.4; 4.3 and 5.2 within 0.0003; with 3 hits 0.0637
-        # and 0.0385). With 5 hits (3.4, 2026-12-03): 0.0759, 0.0573, 0.0542, 0.0333.
+        # The node's helper render (hidden_surfaces.py): the 2nd to 5th surface hits must bring
+        # the node's AO closer to Cycles' AO pass of the same render, and a guard band must not
+        # take it away. Measured at 160x90, 128 spp: RMSE 0.0771 without, 0.0633 with the
+        # layers, 0.0555 with a 16 px band, 0.0381 with both (3.4; 4.3 and 5.2 within 0.0003;
+        # with 3 hits 0.0637 and 0.0385). With 5 hits (3.4, 2026-12-03): 0.0759, 0.0573,
+        # 0.0542, 0.0333. With the surfaces at the frame's border carried on beyond it
+        # (2026-12-05, docs/variants.md): 0.0541, 0.0336, 0.0541, 0.0333: beyond this frame are
+        # the floor and the wall, which their planes at the border give as well as the band.
+        # What only a band shows is tested in tests/unit/test_overscan.cpp and by the POV-Ray
+        # bridge's edge occluders.
         rmse = {}
         for hidden, overscan in (("NONE", 0), ("PEELED", 0), ("NONE", 16), ("PEELED", 16)):
             name = f"layers_{hidden}_{overscan}"
@@ -412,10 +417,10 @@ class AddonTest(unittest.TestCase):
                 (ao[geometry] - passes["AO.R"][geometry]) ** 2)))
             print(f"\n[measure] node AO vs Cycles AO pass, hidden_surfaces={hidden} "
                   f"overscan={overscan}: RMSE {rmse[hidden, overscan]:.4f}", file=sys.stderr)
-        self.assertLess(rmse["PEELED", 0], rmse["NONE", 0] - 0.005)
-        self.assertLess(rmse["NONE", 16], rmse["NONE", 0] - 0.01)
-        self.assertLess(rmse["PEELED", 16], rmse["NONE", 0] - 0.03)
-        self.assertLess(rmse["PEELED", 16], min(rmse["PEELED", 0], rmse["NONE", 16]))
+        self.assertLess(rmse["PEELED", 0], rmse["NONE", 0] - 0.01)
+        self.assertLess(rmse["NONE", 16], rmse["NONE", 0] + 0.002)
+        self.assertLess(rmse["PEELED", 16], rmse["PEELED", 0] + 0.002)
+        self.assertLess(rmse["PEELED", 16], rmse["NONE", 16] - 0.01)
 
     def test_hidden_surfaces_read_cutouts_and_cards(self):
         # Open surfaces with alpha cut-outs (a lattice fence, leaf cards facing either way, a
@@ -424,7 +429,8 @@ class AddonTest(unittest.TestCase):
         # node's defaults must beat one layer without band by 15 %, and the layers alone must
         # not be worse than one layer. Measured at 160x90, 128 spp (3.4, 4.3, 5.2 alike): one
         # layer 0.1142, layers 0.0795 (before: 0.1227), defaults 0.0554 (before: 0.1090; with
-        # 3 hits 0.0796 and 0.0552; with 5 hits, 3.4: 0.1139, 0.0721, 0.0494).
+        # 3 hits 0.0796 and 0.0552; with 5 hits, 3.4: 0.1139, 0.0721, 0.0494; with the
+        # surfaces at the frame's border carried on beyond it, 3.4: 0.0979, 0.0525, 0.0495).
         rmse = {}
         for name, options in (("one", ONE_LAYER), ("layers", ("--hidden-surfaces", "PEELED",
                                                               "--overscan", "0")),
