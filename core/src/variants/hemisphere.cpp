@@ -352,17 +352,18 @@ HWY_INLINE VF beyond_frame_lanes(const HemisphereRowArgs& a, const LaneProjectio
   const VF ahead = ez - sz;
   const VF level = hn::MulAdd(ex, gx, hn::MulAdd(ey, gy, ez * gz));
   counts = hn::And(counts, hn::And(hn::Gt(ahead, zero), hn::Gt(level, plane_level)));
-  VF weight = hn::Min(
-      one, hn::Max(zero, hn::NegMulAdd(ahead, hn::Set(df, 1.0f / a.thickness), hn::Set(df, 2.0f))));
-  if (a.extra_layers > 0 && !hn::AllFalse(df, counts)) {
-    // The border pixel's hits go on beyond the frame too: the sample, `ahead` behind the plane,
-    // stands where a point that far behind the border pixel's visible surface stands among them.
-    VF entry;
-    auto entered = counts, closed = counts;
-    const VF solid = solid_weight_lanes(a, index, counts, qd, qd + ahead, entry, entered, closed);
-    weight = hn::IfThenElseZero(entered, solid);
+  if (hn::AllFalse(df, counts)) return zero;
+  if (a.extra_layers == 0) {  // the visible surface, within the assumed thickness
+    return hn::IfThenElseZero(
+        counts, hn::Min(one, hn::Max(zero, hn::NegMulAdd(ahead, hn::Set(df, 1.0f / a.thickness),
+                                                         hn::Set(df, 2.0f)))));
   }
-  return hn::IfThenElseZero(counts, weight);
+  // The border pixel's hits go on beyond the frame too: the sample, `ahead` behind the plane,
+  // stands where a point that far behind the border pixel's visible surface stands among them.
+  VF entry;
+  auto entered = counts, closed = counts;
+  const VF solid = solid_weight_lanes(a, index, counts, qd, qd + ahead, entry, entered, closed);
+  return hn::IfThenElseZero(hn::And(counts, entered), solid);
 }
 
 // Visibility of pixels [x0, x1) of row y into out[0 .. x1 - x0); kLayers: the frame has extra
@@ -814,10 +815,13 @@ class Hemisphere final : public Variant {
         bool hidden = false, above = false;
         Vec3 surface{}, surface_normal{};
         const bool in_front = f.camera().intrinsics().orthographic || sample.z < 0.0f;
-        if (!pixel_of_sample(f, sample, qx, qy) && in_front) {
-          seen = true;
-          blocked = std::max(blocked, beyond_frame(f, geometric_normal, min_height, p, sample));
-        } else if (in_front) {
+        if (!pixel_of_sample(f, sample, qx, qy)) {
+          // Outside the frame: the surfaces at its border carried on beyond it.
+          if (in_front) {
+            seen = true;
+            blocked = std::max(blocked, beyond_frame(f, geometric_normal, min_height, p, sample));
+          }
+        } else {
           seen = true;
           if (f.is_geometry(qx, qy)) {
             surface = f.position(qx, qy);
@@ -827,20 +831,13 @@ class Hemisphere final : public Variant {
             if (layered && !hidden && above) {
               blocked = std::max(blocked, part);
             }
-            // The surface the sample lies behind (the visible one without extra layers), if any.
-            bool closed = false, past_last = false;
-            const float entry = f.solid_entry(qx, qy, -sample.z, closed, &past_last);
+            // The surface the sample lies behind (the visible one without extra layers), if any,
+            // when above the tangent plane.
+            float entry = Frame::kBackground;
+            const float weight = solid_weight(f, qx, qy, -sample.z, entry);
             if (entry != Frame::kBackground) {
               const Vec3 q = f.camera().view_position(float(qx) + 0.5f, float(qy) + 0.5f, entry);
-              // Inside a solid that a back face closes, or within its thickness (measured beside
-              // the foreground for a hidden last hit, else assumed), when above the tangent
-              // plane.
-              const float measured = past_last ? f.last_thickness(qx, qy) : 0.0f;
               if (dot(q - p, geometric_normal) > min_height) {
-                const float weight =
-                    closed ? 1.0f
-                           : thickness_weight(-sample.z - entry,
-                                              measured > 0.0f ? measured : thickness_);
                 blocked = std::max(blocked, entry == f.depth(qx, qy) ? part * weight : weight);
               }
             }
@@ -906,12 +903,20 @@ class Hemisphere final : public Variant {
     }
     const float ahead = meets.z - sample.z;
     if (!(ahead > 0.0f) || !(dot(meets - p, g) > min_height)) return 0.0f;
-    if (f.extra_layers() == 0) return thickness_weight(ahead, thickness_);
     // The border pixel's hits go on beyond the frame too: the sample, `ahead` behind the plane,
     // stands where a point that far behind the border pixel's visible surface stands among them.
-    const float depth = f.depth(qx, qy) + ahead;
+    float entry = Frame::kBackground;
+    return solid_weight(f, qx, qy, f.depth(qx, qy) + ahead, entry);
+  }
+
+  // Frame::solid_entry for a point at planar depth `depth` on the ray of pixel (qx, qy), into
+  // `entry`, and how much the solid it lies in occludes it: 1 inside a solid that a back face
+  // closes, else by the solid's thickness (measured beside the foreground for the ray's last
+  // hit, Frame::last_thickness, else assumed); 0 where entry is kBackground (the point is in
+  // front of the visible surface or in free space). The vector path's solid_weight_lanes.
+  float solid_weight(const Frame& f, int qx, int qy, float depth, float& entry) const {
     bool closed = false, past_last = false;
-    const float entry = f.solid_entry(qx, qy, depth, closed, &past_last);
+    entry = f.solid_entry(qx, qy, depth, closed, &past_last);
     if (entry == Frame::kBackground) return 0.0f;
     const float measured = past_last ? f.last_thickness(qx, qy) : 0.0f;
     return closed ? 1.0f : thickness_weight(depth - entry, measured > 0.0f ? measured : thickness_);
