@@ -68,8 +68,8 @@ const char* const kUsage =
     "over the pixels whose depth is finite, > 0 and < 0.9 * clip_end (the geometry pixels).\n"
     "mean_error is the mean of (method - truth): positive means too little occlusion. time_ms\n"
     "is the median of --repeat runs of the AO computation alone (no file I/O), min_ms the\n"
-    "fastest; the methods run in interleaved rounds (A B C A B C ...) after one untimed round,\n"
-    "each timed run right after an untimed run of the same method.\n"
+    "fastest; the methods run in interleaved rounds (A B C A B C ...), each timed run right\n"
+    "after an untimed run of the same method.\n"
     "An image method is not timed (nan). rmse_interior leaves out the pixels beside one outside\n"
     "that set: on a silhouette against the sky Cycles' pass reads coverage x AO (sky samples\n"
     "add nothing).\n"
@@ -858,16 +858,13 @@ Method make_method(const std::string& name, const std::vector<Setting>& settings
   return m;
 }
 
-// Wall times in milliseconds of `repeat` runs of every timed method, in interleaved rounds,
-// after one untimed round (first-touch page faults, thread start-up). Each timed run follows an
-// untimed run of the same method: the first run with two threads after a method on one thread
-// (the seed ports) took 1.6x as long on this 2-core VM (the idle core waking), which made the
-// default, first in each round, look slower than `resolution=half`, the same settings.
+// Wall times in milliseconds of `repeat` runs of every timed method, in interleaved rounds.
+// Each timed run follows an untimed run of the same method, which also takes the first-touch
+// page faults and the thread start-up: the first run with two threads after a method on one
+// thread (the seed ports) took 1.6x as long on this 2-core VM (the idle core waking), which made
+// the default, first in each round, look slower than `resolution=half`, the same settings.
 std::vector<std::vector<double>> time_interleaved(const std::vector<Method>& methods, int repeat) {
   std::vector<std::vector<double>> times(methods.size());
-  for (const Method& m : methods) {
-    if (m.run) m.run();
-  }
   for (int round = 0; round < repeat; ++round) {
     for (size_t i = 0; i < methods.size(); ++i) {
       if (!methods[i].run) continue;
