@@ -89,6 +89,122 @@ SSAO_VECTORIZE void Frame::plane_distance_scale_row(int x0, int count, int y,
   }
 }
 
+namespace {
+// The tangent plane dot(x, n) = w of the surface beyond a stop of a walk (Frame::carried_depth),
+// and its packed normal; `usable` false where the stop is not a step onto a farther surface.
+struct CarriedPlane {
+  bool usable = false;
+  float nx = 0, ny = 0, nz = 0, w = 0;
+  uint32_t packed = 0;
+};
+}  // namespace
+
+// Per tile, each of the four walks is a scan towards the pixels from kCarrySearch pixels beyond
+// the tile's edge, keeping the nearest stop seen so far (a step onto a farther surface, or
+// background) with its surface's plane: O(pixels) however far the search reaches, one plane per
+// stop, and per pixel where its ray meets the plane.
+void Frame::find_carried_surfaces(TilePool& pool, Progress& progress) {
+  if (extra_layers_ > 0 || normal_.empty()) {
+    std::vector<float>().swap(carried_depth_);
+    std::vector<uint32_t>().swap(carried_normal_);
+    return;
+  }
+  carried_depth_.resize(pixel_count());
+  carried_normal_.resize(pixel_count());
+  const CameraIntrinsics cam = camera_.intrinsics();
+  // The plane of the surface a walk in direction (dx, dy) steps onto at (x, y): that of the pixel
+  // past it where the surface goes on there (the first pixel across is often a mix of both in
+  // the Normal pass).
+  const auto plane_at = [&](int x, int y, int dx, int dy) {
+    CarriedPlane plane;
+    const float far_side = depth(x, y);
+    if (far_side == kBackground) return plane;
+    const int gx = x + dx, gy = y + dy;
+    if (gx >= 0 && gy >= 0 && gx < width_ && gy < height_ &&
+        depth(gx, gy) < far_side * kCarryJump && far_side < depth(gx, gy) * kCarryJump) {
+      x = gx, y = gy;
+    }
+    const uint32_t packed = normal_[index(x, y)];
+    const Vec3 n = decode_normal(packed), q = position(x, y);
+    return CarriedPlane{true, n.x, n.y, n.z, dot(q, n), packed};
+  };
+  // Whole rows: the walks along a row need no pixels beyond the band, and those along a column
+  // kCarrySearch rows beyond it, a fraction of its kCarryBandRows.
+  constexpr int kCarryBandRows = 64;
+  pool.for_each_row_band(width_, height_, kCarryBandRows, progress, [&](const Tile& t) {
+    const int w = width_, h = t.y1 - t.y0;
+    ScratchVector<float> best(size_t(w) * size_t(h));
+    ScratchVector<uint8_t> nearest(size_t(w) * size_t(h));
+    std::fill(best.begin(), best.end(), kBackground);
+    std::fill(nearest.begin(), nearest.end(), uint8_t(kCarrySearch + 1));
+    uint32_t* normals_out = carried_normal_.data() + index(0, t.y0);
+    // Pixel (x, y) of depth d, `distance` pixels from the stop whose plane is `plane`: where its
+    // ray meets the plane, if farther than its surface by kCarryJump and the nearest so far.
+    const auto consider = [&](int x, int y, float d, const CarriedPlane& plane, int distance) {
+      const size_t slot = size_t(y - t.y0) * size_t(w) + size_t(x);
+      if (!plane.usable || distance > nearest[slot] || d == kBackground) return;
+      // The ray through the pixel's centre: (a, b, 0) + t (0, 0, -1) or t (a, b, -1).
+      const float a = (float(x) + 0.5f - cam.center_u) * cam.scale_u;
+      const float b = (cam.center_v - (float(y) + 0.5f)) * cam.scale_v;
+      const float across = plane.nx * a + plane.ny * b;
+      const float slope = cam.orthographic ? plane.nz : across - plane.nz;
+      if (!(std::fabs(slope) > 1e-6f)) return;  // the ray runs along the plane
+      const float meets = (cam.orthographic ? across - plane.w : plane.w) / slope;
+      if (!(meets > d * kCarryJump) || !(meets < kBackground)) return;
+      if (distance < nearest[slot] || meets < best[slot]) {
+        nearest[slot] = uint8_t(distance);
+        best[slot] = meets;
+        normals_out[slot] = plane.packed;
+      }
+    };
+    // Along rows, right then left, scanning against the walk: the nearest stop ahead (a pixel of
+    // background, or a step from the pixel before onto a surface farther by kCarryJump).
+    for (int y = t.y0; y < t.y1; ++y) {
+      const float* row = depth_.data() + index(0, y);
+      for (const int dx : {1, -1}) {
+        int stop = -1;
+        CarriedPlane plane;
+        for (int x = dx > 0 ? w - 1 : 0; x >= 0 && x < w; x -= dx) {
+          if (stop >= 0 && std::abs(stop - x) <= kCarrySearch) {
+            consider(x, y, row[x], plane, std::abs(stop - x));
+          }
+          const int before = x - dx;
+          if (row[x] == kBackground ||
+              (before >= 0 && before < w && row[x] > row[before] * kCarryJump)) {
+            stop = x, plane = plane_at(x, y, dx, 0);
+          }
+        }
+      }
+    }
+    // Along columns, down then up, the same with one stop per column.
+    ScratchVector<int> stop(static_cast<size_t>(w));
+    ScratchVector<CarriedPlane> plane(static_cast<size_t>(w));
+    for (const int dy : {1, -1}) {
+      std::fill(stop.begin(), stop.end(), -1);
+      const int begin = dy > 0 ? std::min(t.y1 - 1 + kCarrySearch, height_ - 1)
+                               : std::max(t.y0 - kCarrySearch, 0);
+      const int end = dy > 0 ? t.y0 - 1 : t.y1;
+      for (int y = begin; y != end; y -= dy) {
+        const float* row = depth_.data() + index(0, y);
+        const int before = y - dy;
+        const float* row_before =
+            before >= 0 && before < height_ ? depth_.data() + index(0, before) : nullptr;
+        const bool inside = y >= t.y0 && y < t.y1;
+        for (int x = 0; x < w; ++x) {
+          if (inside && stop[size_t(x)] >= 0 && std::abs(stop[size_t(x)] - y) <= kCarrySearch) {
+            consider(x, y, row[x], plane[size_t(x)], std::abs(stop[size_t(x)] - y));
+          }
+          if (row[x] == kBackground ||
+              (row_before != nullptr && row[x] > row_before[x] * kCarryJump)) {
+            stop[size_t(x)] = y, plane[size_t(x)] = plane_at(x, y, 0, dy);
+          }
+        }
+      }
+    }
+    std::copy(best.begin(), best.end(), carried_depth_.data() + index(0, t.y0));
+  });
+}
+
 // A solid whose front face is the ray's last known hit, hidden behind the visible surface, has
 // its back beyond the layers; the thickness rule would make a 6 cm column behind a fence post
 // as deep as `thickness` (25 cm on the benchmark's `thin`). Where the same surface is visible
@@ -257,6 +373,7 @@ void Frame::build(const FrameInputs& in, TilePool& pool, Progress& progress) {
   unmix_normals(pool, progress);
   infer_last_thickness(pool, progress);
   measure_plane_distance_scale(pool, progress);
+  find_carried_surfaces(pool, progress);
 }
 
 void Frame::build_depth(const FrameInputs& in, TilePool& pool, Progress& progress) {
@@ -265,6 +382,7 @@ void Frame::build_depth(const FrameInputs& in, TilePool& pool, Progress& progres
   std::vector<uint8_t>().swap(mixed_normal_);
   std::vector<float>().swap(last_thickness_);
   std::vector<float>().swap(plane_distance_scale_);
+  std::vector<float>().swap(carried_depth_);
 }
 
 void Frame::fill_depth(const FrameInputs& in, TilePool& pool, Progress& progress) {
@@ -625,6 +743,7 @@ void Frame::downsample(const Frame& full, const FrameInputs& in, TilePool& pool,
   unmix_normals(pool, progress);
   infer_last_thickness(pool, progress);
   measure_plane_distance_scale(pool, progress);
+  find_carried_surfaces(pool, progress);
 }
 
 float background_limit(double background_depth, double clip_end) {

@@ -175,6 +175,27 @@ class Frame {
     return extra_layers_ > 0 ? plane_distance_scale_[index(x, y)] : 0.0f;
   }
 
+  // Without extra layers, per pixel: the planar depth at which the pixel's ray meets the surface
+  // beyond the nearest silhouette around it, carried on behind the object as its tangent plane
+  // (the floor going on under a sphere): walking from the pixel along its row or column, the
+  // first step onto a surface more than kCarryJump farther, within kCarrySearch pixels, on the
+  // nearest such side whose plane the ray meets more than kCarryJump behind the pixel's own
+  // surface; kBackground where none. Null with extra layers (they show the hidden surfaces) or
+  // without normals.
+  const float* carried_depth_plane() const {
+    return carried_depth_.empty() ? nullptr : carried_depth_.data();
+  }
+  float carried_depth(int x, int y) const {
+    return carried_depth_.empty() ? kBackground : carried_depth_[index(x, y)];
+  }
+  // The carried surface's packed normal (encode_normal), where carried_depth is not background.
+  const uint32_t* carried_normal_plane() const {
+    return carried_normal_.empty() ? nullptr : carried_normal_.data();
+  }
+  Vec3 carried_normal(int x, int y) const { return decode_normal(carried_normal_[index(x, y)]); }
+  static constexpr int kCarrySearch = 24;
+  static constexpr float kCarryJump = 1.05f;
+
  private:
   Vec3 reconstructed_normal(int x, int y) const;
   void fill_depth(const FrameInputs& in, TilePool& pool, Progress& progress);
@@ -202,6 +223,8 @@ class Frame {
   // Fills plane_distance_scale_ from the finished depth and normal planes.
   void measure_plane_distance_scale(TilePool& pool, Progress& progress);
   void plane_distance_scale_row(int x0, int count, int y, float* out) const;
+  // Fills carried_depth_ from the finished depth and normal planes.
+  void find_carried_surfaces(TilePool& pool, Progress& progress);
   static void hidden_last_fronts(const float* layers, size_t plane, int extra_layers, int count,
                                  float* last);
   static bool search_step(const float* last, const float* visible, const float* layers,
@@ -225,6 +248,8 @@ class Frame {
   std::vector<float> layers_;
   std::vector<float> last_thickness_;
   std::vector<float> plane_distance_scale_;
+  std::vector<float> carried_depth_;
+  std::vector<uint32_t> carried_normal_;
 };
 
 }  // namespace ssao

@@ -34,6 +34,8 @@ struct HemisphereRowArgs {
   const float* layers;                // the frame's extra depth layers (Frame::layer_planes)
   const float* last_thickness;        // Frame::last_thickness_plane
   const float* plane_distance_scale;  // Frame::plane_distance_scale_plane
+  const float* carried_depth;         // Frame::carried_depth_plane (null: none)
+  const uint32_t* carried_normals;    // Frame::carried_normal_plane
   int extra_layers;
   bool surface_normals;  // the tangent-plane tests use Frame::surface_normal (else the normal)
   int width, height;
@@ -500,8 +502,39 @@ HWY_NOINLINE void hemisphere_row_of(const HemisphereRowArgs& a, int y, int x0, i
           const VF level = hn::MulAdd(qxv, gx, hn::MulAdd(qyv, gy, qzv * gz));
           const auto counts = hn::And(hn::And(in_image, hn::Lt(qd, inf)),
                                       hn::And(hn::Gt(behind, zero), hn::Gt(level, plane_level)));
-          const VF weight = hn::Min(one, hn::Max(zero, two - behind * inv_thickness));
-          blocked = hn::Max(blocked, hn::IfThenElseZero(counts, weight));
+          const VF weight =
+              hn::IfThenElseZero(counts, hn::Min(one, hn::Max(zero, two - behind * inv_thickness)));
+          blocked = hn::Max(blocked, weight);
+          // Hidden beyond that solid's reach: the surface beyond the nearest silhouette, carried
+          // on behind the object (Frame::carried_depth), occludes within the assumed thickness
+          // when the receiver lies in front of it and it is above the tangent plane.
+          if (a.carried_depth != nullptr) {
+            const auto deeper =
+                hn::And(hn::And(in_image, hn::Lt(qd, inf)),
+                        hn::And(hn::Gt(behind, zero), hn::Lt(hn::Max(blocked, weight), one)));
+            if (!hn::AllFalse(df, deeper)) {
+              const VI index = qy * hn::Set(di, a.width) + qx;
+              const VF carried = hn::GatherIndex(df, a.carried_depth, index);
+              const VF past = hn::Neg(sz) - carried;  // > 0: the sample lies behind it
+              const VF c_scale = cam.orthographic ? one : carried;
+              const VF cxv = ray_x * c_scale, cyv = ray_y * c_scale, czv = hn::Neg(carried);
+              const VF carried_level = hn::MulAdd(cxv, gx, hn::MulAdd(cyv, gy, czv * gz));
+              const auto carries =
+                  hn::And(hn::And(deeper, hn::Gt(past, zero)), hn::Gt(carried_level, plane_level));
+              if (!hn::AllFalse(df, carries)) {
+                VF cnx, cny, cnz;
+                decode_directions(
+                    df,
+                    hn::GatherIndex(di, reinterpret_cast<const int32_t*>(a.carried_normals), index),
+                    cnx, cny, cnz);
+                const VF side =
+                    hn::MulAdd(px - cxv, cnx, hn::MulAdd(py - cyv, cny, (pz - czv) * cnz));
+                const VF carried_weight = hn::Min(one, hn::Max(zero, two - past * inv_thickness));
+                blocked = hn::Max(blocked, hn::IfThenElseZero(hn::And(carries, hn::Gt(side, zero)),
+                                                              carried_weight));
+              }
+            }
+          }
         } else {
           const VI qx = hn::ConvertTo(di, hn::IfThenElseZero(in_image, su));
           const VI qy = hn::ConvertTo(di, hn::IfThenElseZero(in_image, sv));
@@ -715,6 +748,8 @@ class Hemisphere final : public Variant {
                                  f.layer_planes(),
                                  f.last_thickness_plane(),
                                  f.plane_distance_scale_plane(),
+                                 f.carried_depth_plane(),
+                                 f.carried_normal_plane(),
                                  f.extra_layers(),
                                  f.normals_from_image() && f.width() >= 3 && f.height() >= 3,
                                  f.width(),
@@ -835,11 +870,17 @@ class Hemisphere final : public Variant {
             // when above the tangent plane.
             float entry = Frame::kBackground;
             const float weight = solid_weight(f, qx, qy, -sample.z, entry);
+            float solid = 0.0f;
             if (entry != Frame::kBackground) {
               const Vec3 q = f.camera().view_position(float(qx) + 0.5f, float(qy) + 0.5f, entry);
               if (dot(q - p, geometric_normal) > min_height) {
-                blocked = std::max(blocked, entry == f.depth(qx, qy) ? part * weight : weight);
+                solid = entry == f.depth(qx, qy) ? part * weight : weight;
+                blocked = std::max(blocked, solid);
               }
+            }
+            if (hidden && !layered && blocked < 1.0f) {
+              blocked =
+                  std::max(blocked, carried(f, qx, qy, p, geometric_normal, min_height, sample));
             }
           }
         }
@@ -907,6 +948,23 @@ class Hemisphere final : public Variant {
     // stands where a point that far behind the border pixel's visible surface stands among them.
     float entry = Frame::kBackground;
     return solid_weight(f, qx, qy, f.depth(qx, qy) + ahead, entry);
+  }
+
+  // A sample hidden behind the visible surface of pixel (qx, qy), without extra layers: the
+  // weight with which the surface beyond the nearest silhouette, carried on behind the object
+  // (Frame::carried_depth), occludes it within the assumed thickness, when the receiver p lies
+  // in front of it and it is above the tangent plane (normal g); else 0.
+  float carried(const Frame& f, int qx, int qy, Vec3 p, Vec3 g, float min_height,
+                Vec3 sample) const {
+    const float depth = f.carried_depth(qx, qy);
+    if (depth == Frame::kBackground) return 0.0f;
+    const float past = -sample.z - depth;
+    const Vec3 c = f.camera().view_position(float(qx) + 0.5f, float(qy) + 0.5f, depth);
+    if (!(past > 0.0f) || !(dot(c - p, g) > min_height) ||
+        !(dot(p - c, f.carried_normal(qx, qy)) > 0.0f)) {
+      return 0.0f;
+    }
+    return thickness_weight(past, thickness_);
   }
 
   // Frame::solid_entry for a point at planar depth `depth` on the ray of pixel (qx, qy), into
