@@ -516,13 +516,21 @@ class AddonTest(unittest.TestCase):
         core = (slice(margin, -margin), slice(margin, -margin))
         geometry = (depth < 1e9)[core]
         difference = np.abs(crop[core] - inside[core])[geometry]
+        differing = int((difference > 1e-3).sum())
         print(f"\n[measure] render border with crop: AO of the crop vs the whole frame's, "
               f"{difference.size} px {margin} px inside the crop: largest |difference| "
-              f"{difference.max():.2e}", file=sys.stderr)
-        # Measured: 1.8e-7 (3.4.1), 1.2e-7 (5.2.2). With the crop's top row not a multiple of
-        # 8 (a border to 0.8) the sample pattern alone makes 0.011 on average, 0.06 at the
-        # 99th percentile.
-        self.assertLess(difference.max(), 1e-3)
+              f"{difference.max():.2e}, {differing} px over 1e-3", file=sys.stderr)
+        # Measured: 1.8e-7 (3.4.1), 1.2e-7 (5.2.2) before the surfaces beyond silhouettes were
+        # carried on (docs/variants.md, hemisphere item 7): a pixel's carried plane comes from
+        # pixels up to 24 px away, which for samples in the band are the helper render's
+        # (1 spp: its Normal unfiltered, its Depth at a silhouette now and then the other
+        # surface's), where the whole frame has the user's passes. Since then a few pixels
+        # differ: 0.011 at most, 12 of 3136 px over 1e-3 (3.4.1). With the crop's top row not
+        # a multiple of 8 (a border to 0.8) the sample pattern alone makes 0.011 on average,
+        # 0.06 at the 99th percentile.
+        self.assertLess(np.median(difference), 1e-5)
+        self.assertLessEqual(differing, difference.size // 100)
+        self.assertLess(difference.max(), 0.05)
         result = os.path.join(self.folder("crop_helper"), "first_hits.json")
         blend = self.blender.build_scene("crop_helper/scene", "--render-features",
                                          "--border", *border)
