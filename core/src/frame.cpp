@@ -383,6 +383,7 @@ void Frame::build_depth(const FrameInputs& in, TilePool& pool, Progress& progres
   std::vector<float>().swap(last_thickness_);
   std::vector<float>().swap(plane_distance_scale_);
   std::vector<float>().swap(carried_depth_);
+  std::vector<uint32_t>().swap(carried_normal_);
 }
 
 void Frame::fill_depth(const FrameInputs& in, TilePool& pool, Progress& progress) {

@@ -2,7 +2,8 @@
 // The frame the variants read: one plane of planar depth (+inf = background) and one plane of
 // packed unit normals, prepared once per run from the caller's depth (and normal) images.
 // Positions are reconstructed from depth on the fly: two multiplies are cheaper than the memory
-// traffic of a stored position, and the two planes are 8 bytes a pixel.
+// traffic of a stored position, and the two planes are 8 bytes a pixel (with one layer, two
+// more for the surfaces carried on behind silhouettes: carried_depth_plane).
 #pragma once
 
 #include <cmath>

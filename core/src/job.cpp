@@ -546,9 +546,10 @@ void Job::run() {
     frame.build(in, tiles, progress);
   }
   const Frame& seen = half_resolution ? half_frame_ : frame;
-  // At most three image-size buffers: the full frame's two planes and one of visibility (or the
-  // full frame's depth plane, and the half frame's planes and visibility, a quarter each). What
-  // the other mode kept is freed (build_depth frees the full frame's normal plane).
+  // With one layer at most five image-size buffers: the full frame's four planes (depth, normal,
+  // carried depth and normal) and one of visibility (or the full frame's depth plane, and the
+  // half frame's planes and visibility, a quarter each). What the other mode kept is freed
+  // (build_depth frees the full frame's other planes).
   if (!half_resolution) half_frame_ = Frame();
   const size_t estimates = size_t(seen.width()) * size_t(seen.height());
   if (visibility_.capacity() > estimates) std::vector<float>().swap(visibility_);
