@@ -862,8 +862,12 @@ class AddonTest(unittest.TestCase):
         self.assertEqual([r["helper_renders"] for r in report], [2, 2, 3], report)
         means = [r["ao_mean"] for r in report]
         self.assertLess(means[0], 0.97)
-        self.assertGreater(abs(means[1] - means[0]), 1e-4, report)
-        self.assertGreater(abs(means[2] - means[1]), 1e-4, report)
+        # Each change changes the AO: compared pixel by pixel (every 37th), as one layer's
+        # mean can equal the layers' (0.88810 against 0.88806 in 4.3.2 with the carried
+        # surfaces) where the pictures differ.
+        samples = [np.array(r["ao_sample"]) for r in report]
+        self.assertGreater(float(np.abs(samples[1] - samples[0]).max()), 1e-3, means)
+        self.assertGreater(float(np.abs(samples[2] - samples[1]).max()), 1e-3, means)
 
     def ui_f12(self, name, *options):
         folder = self.folder(name)
