@@ -490,7 +490,8 @@ HWY_NOINLINE void hemisphere_row_of(const HemisphereRowArgs& a, int y, int x0, i
           if (hn::AllFalse(df, in_image)) continue;
           const VI qx = hn::ConvertTo(di, hn::IfThenElseZero(in_image, su));
           const VI qy = hn::ConvertTo(di, hn::IfThenElseZero(in_image, sv));
-          const VF qd = hn::GatherIndex(df, a.depth, qy * hn::Set(di, a.width) + qx);
+          const VI index = qy * hn::Set(di, a.width) + qx;
+          const VF qd = hn::GatherIndex(df, a.depth, index);
           // The visible surface at that pixel (Frame::position), occluding within the assumed
           // thickness when above the tangent plane.
           const VF q_scale = cam.orthographic ? one : qd;
@@ -509,11 +510,9 @@ HWY_NOINLINE void hemisphere_row_of(const HemisphereRowArgs& a, int y, int x0, i
           // on behind the object (Frame::carried_depth), occludes within the assumed thickness
           // when the receiver lies in front of it and it is above the tangent plane.
           if (a.carried_depth != nullptr) {
-            const auto deeper =
-                hn::And(hn::And(in_image, hn::Lt(qd, inf)),
-                        hn::And(hn::Gt(behind, zero), hn::Lt(hn::Max(blocked, weight), one)));
+            const auto deeper = hn::And(hn::And(in_image, hn::Lt(qd, inf)),
+                                        hn::And(hn::Gt(behind, zero), hn::Lt(blocked, one)));
             if (!hn::AllFalse(df, deeper)) {
-              const VI index = qy * hn::Set(di, a.width) + qx;
               const VF carried = hn::GatherIndex(df, a.carried_depth, index);
               const VF past = hn::Neg(sz) - carried;  // > 0: the sample lies behind it
               const VF c_scale = cam.orthographic ? one : carried;
@@ -870,12 +869,10 @@ class Hemisphere final : public Variant {
             // when above the tangent plane.
             float entry = Frame::kBackground;
             const float weight = solid_weight(f, qx, qy, -sample.z, entry);
-            float solid = 0.0f;
             if (entry != Frame::kBackground) {
               const Vec3 q = f.camera().view_position(float(qx) + 0.5f, float(qy) + 0.5f, entry);
               if (dot(q - p, geometric_normal) > min_height) {
-                solid = entry == f.depth(qx, qy) ? part * weight : weight;
-                blocked = std::max(blocked, solid);
+                blocked = std::max(blocked, entry == f.depth(qx, qy) ? part * weight : weight);
               }
             }
             if (hidden && !layered && blocked < 1.0f) {
