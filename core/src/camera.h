@@ -88,6 +88,16 @@ class CameraModel {
     return true;
   }
 
+  // Planar depth at which the ray through continuous image coordinates (u, v) meets the plane
+  // dot(x, n) = w; false where the ray runs along the plane.
+  bool depth_on_plane(float u, float v, Vec3 n, float w, float& planar_depth) const {
+    const Vec3 origin = view_position(u, v, 0.0f);
+    const float slope = dot(view_position(u, v, 1.0f) - origin, n);
+    if (!(std::fabs(slope) > 1e-6f)) return false;
+    planar_depth = (w - dot(origin, n)) / slope;
+    return true;
+  }
+
   // Direction from the point towards the camera (unit), for orienting normals.
   Vec3 towards_camera(Vec3 p) const {
     return orthographic_ ? Vec3{0.0f, 0.0f, 1.0f} : normalize_or(-p, Vec3{0.0f, 0.0f, 1.0f});

@@ -94,7 +94,8 @@ namespace {
 // and its packed normal; `usable` false where the stop is not a step onto a farther surface.
 struct CarriedPlane {
   bool usable = false;
-  float nx = 0, ny = 0, nz = 0, w = 0;
+  Vec3 n{0.0f, 0.0f, 0.0f};
+  float w = 0.0f;
   uint32_t packed = 0;
 };
 }  // namespace
@@ -111,7 +112,6 @@ void Frame::find_carried_surfaces(TilePool& pool, Progress& progress) {
   }
   carried_depth_.resize(pixel_count());
   carried_normal_.resize(pixel_count());
-  const CameraIntrinsics cam = camera_.intrinsics();
   // The plane of the surface a walk in direction (dx, dy) steps onto at (x, y): that of the pixel
   // past it where the surface goes on there (the first pixel across is often a mix of both in
   // the Normal pass).
@@ -126,7 +126,7 @@ void Frame::find_carried_surfaces(TilePool& pool, Progress& progress) {
     }
     const uint32_t packed = normal_[index(x, y)];
     const Vec3 n = decode_normal(packed), q = position(x, y);
-    return CarriedPlane{true, n.x, n.y, n.z, dot(q, n), packed};
+    return CarriedPlane{true, n, dot(q, n), packed};
   };
   // Whole rows: the walks along a row need no pixels beyond the band, and those along a column
   // kCarrySearch rows beyond it, a fraction of its kCarryBandRows.
@@ -143,14 +143,11 @@ void Frame::find_carried_surfaces(TilePool& pool, Progress& progress) {
     const auto consider = [&](int x, int y, float d, const CarriedPlane& plane, int distance) {
       const size_t slot = size_t(y - t.y0) * size_t(w) + size_t(x);
       if (!plane.usable || distance > nearest[slot] || d == kBackground) return;
-      // The ray through the pixel's centre: (a, b, 0) + t (0, 0, -1) or t (a, b, -1).
-      const float a = (float(x) + 0.5f - cam.center_u) * cam.scale_u;
-      const float b = (cam.center_v - (float(y) + 0.5f)) * cam.scale_v;
-      const float across = plane.nx * a + plane.ny * b;
-      const float slope = cam.orthographic ? plane.nz : across - plane.nz;
-      if (!(std::fabs(slope) > 1e-6f)) return;  // the ray runs along the plane
-      const float meets = (cam.orthographic ? across - plane.w : plane.w) / slope;
-      if (!(meets > d * kCarryJump) || !(meets < kBackground)) return;
+      float meets;
+      if (!camera_.depth_on_plane(float(x) + 0.5f, float(y) + 0.5f, plane.n, plane.w, meets) ||
+          !(meets > d * kCarryJump) || !(meets < kBackground)) {
+        return;
+      }
       if (distance < nearest[slot] || meets < best[slot]) {
         nearest[slot] = uint8_t(distance);
         best[slot] = meets;

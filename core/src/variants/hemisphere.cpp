@@ -1068,13 +1068,12 @@ class Hemisphere final : public Variant {
   // How far the surface pixel (x, y) shows lies behind the plane through q with normal nq, along
   // the ray through the pixel's centre; false on background or a ray along the plane.
   static bool behind_plane(const Frame& f, int x, int y, Vec3 q, Vec3 nq, float& behind) {
-    if (!f.is_geometry(x, y)) return false;
-    const CameraModel& cam = f.camera();
-    const float u = float(x) + 0.5f, v = float(y) + 0.5f;
-    const Vec3 origin = cam.view_position(u, v, 0.0f);
-    const float slope = dot(cam.view_position(u, v, 1.0f) - origin, nq);
-    if (!(std::fabs(slope) > 1e-6f)) return false;
-    behind = f.depth(x, y) - dot(q - origin, nq) / slope;
+    float meets;
+    if (!f.is_geometry(x, y) ||
+        !f.camera().depth_on_plane(float(x) + 0.5f, float(y) + 0.5f, nq, dot(q, nq), meets)) {
+      return false;
+    }
+    behind = f.depth(x, y) - meets;
     return true;
   }
 
