@@ -35,19 +35,12 @@ def node():
     return addon_module("compute").ssao_nodes(bpy.context.scene)[0]
 
 
-def ao_pixels(n):
+def ao_summary(n):
+    """The AO image's mean and every 37th pixel's AO (enough to tell two results apart where
+    their means agree), from one read of its pixels."""
     image = addon_module("inner_tree").ao_image_if_any(n)
-    return list(image.pixels)[0::4] if image is not None else []
-
-
-def ao_mean(n):
-    pixels = ao_pixels(n)
-    return sum(pixels) / len(pixels) if pixels else None
-
-
-def ao_sample(n):
-    """Every 37th pixel's AO: enough to tell two results apart where their means agree."""
-    return ao_pixels(n)[::37]
+    pixels = list(image.pixels)[0::4] if image is not None else []
+    return (sum(pixels) / len(pixels) if pixels else None), pixels[::37]
 
 
 def count_helper_renders(scene, *_):
@@ -102,8 +95,9 @@ def step():
             STATE["idle_since"] = time.monotonic()
             return 1.0
         n = node()
+        mean, sample = ao_summary(n)
         STATE["report"].append({"step": STEPS[STATE["step"]][0], "status": n.status,
-                                "ao_mean": ao_mean(n), "ao_sample": ao_sample(n),
+                                "ao_mean": mean, "ao_sample": sample,
                                 "helper_renders": STATE["helper_renders"] +
                                 state.helpers_started})
         if STATE["stale"] is not None:
