@@ -611,7 +611,7 @@ void Job::run() {
     const Tile t{output.x0 + dx, output.y0 + dy, output.x1 + dx, output.y1 + dy};
     ScratchVector<float> denoised(size_t(t.x1 - t.x0) * size_t(t.y1 - t.y0));
     ScratchVector<float> coverage(composite_out_.attached() ? size_t(t.x1 - t.x0) : 0);
-    ScratchVector<uint8_t> beside(coverage.size());
+    ScratchVector<uint8_t> beside(normal_.attached() ? coverage.size() : 0);  // coverage_row's
     const bool sky = !frame.has_geometry(t.x0, t.y0, t.x1, t.y1);
     // The visibility resolved at full resolution over `resolved` (the tile, or with the pixel
     // filter the tile and the pixels around it that the filter reads).
