@@ -153,6 +153,15 @@ HWY_INLINE VF end_part_lanes(const HemisphereRowArgs& a, VF past) {
   return hn::MulAdd(past, hn::Set(df, a.half_inv_end_width), hn::Set(df, 0.5f));
 }
 
+// Hemisphere::covered on lanes: the part of a sample's cone behind a surface's plane, from how
+// far behind it the sample lies (negative: in front); not clamped.
+template <class VF>
+HWY_INLINE VF cone_part_lanes(VF behind, VF half_inv_width) {
+  namespace hn = hwy::HWY_NAMESPACE;
+  const hn::DFromV<VF> df;
+  return hn::MulAdd(behind, half_inv_width, hn::Set(df, 0.5f));
+}
+
 // Hemisphere::crossing on the lanes of `candidate`, whose points a and b lie on either side of
 // the plane dot(x, c) = w: where the depth image shows the plane, or something in front of it,
 // at the point where the segment meets the plane, the part of the direction's cone past the
@@ -218,7 +227,7 @@ HWY_INLINE VF between_lanes(const HemisphereRowArgs& a, const LaneProjection<VF>
   namespace hn = hwy::HWY_NAMESPACE;
   const hn::DFromV<VF> df;
   const hn::RebindToSigned<decltype(df)> di;
-  const VF zero = hn::Zero(df), one = hn::Set(df, 1.0f), half = hn::Set(df, 0.5f);
+  const VF zero = hn::Zero(df), one = hn::Set(df, 1.0f);
   VF mu, mv;
   const auto lanes = hn::And(candidate, project(mx, my, mz, mu, mv));
   if (hn::AllFalse(df, lanes)) return zero;
@@ -248,7 +257,7 @@ HWY_INLINE VF between_lanes(const HemisphereRowArgs& a, const LaneProjection<VF>
   const VF side_e = hn::MulAdd(ex - qxv, cx, hn::MulAdd(ey - qyv, cy, (ez - qzv) * cz));
   const VF past_end = hn::Neg(side_e) / hn::Sqrt(hn::MulAdd(cx, cx, hn::MulAdd(cy, cy, cz * cz)));
   const VF covered =
-      hn::Min(one, hn::Max(zero, hn::Max(hn::MulAdd(behind * scale, half_inv_width, half),
+      hn::Min(one, hn::Max(zero, hn::Max(cone_part_lanes(behind * scale, half_inv_width),
                                          end_part_lanes(a, past_end))));
   const VF thick = hn::Min(one, hn::Max(zero, hn::NegMulAdd(behind, hn::Set(df, 1.0f / a.thickness),
                                                             hn::Set(df, 2.0f))));
@@ -503,7 +512,7 @@ HWY_NOINLINE void hemisphere_row_of(const HemisphereRowArgs& a, int y, int x0, i
           const auto above =
               hn::And(hn::And(in_image, hn::Lt(qd, inf)), hn::Gt(level, plane_level));
           const VF covered =
-              hn::Min(one, hn::Max(zero, hn::MulAdd(behind, hn::LoadU(df, cone), half)));
+              hn::Min(one, hn::Max(zero, cone_part_lanes(behind, hn::LoadU(df, cone))));
           const VF thick = hn::Min(one, hn::Max(zero, two - behind * inv_thickness));
           blocked = hn::Max(blocked, hn::IfThenElseZero(above, covered * thick));
           // Hidden beyond that solid's reach: the surface beyond the nearest silhouette, carried
@@ -575,7 +584,7 @@ HWY_NOINLINE void hemisphere_row_of(const HemisphereRowArgs& a, int y, int x0, i
             if (!hn::AllFalse(df, above)) {
               const VF scale = hn::GatherIndex(df, a.plane_distance_scale, index);
               covered =
-                  hn::Min(one, hn::Max(zero, hn::MulAdd(behind * scale, half_inv_width, half)));
+                  hn::Min(one, hn::Max(zero, cone_part_lanes(behind * scale, half_inv_width)));
               blocked = hn::Max(blocked, hn::IfThenElseZero(hn::AndNot(hidden, above), covered));
             }
             if (!hn::AllFalse(df, hidden)) {
