@@ -45,6 +45,17 @@ HWY_INLINE void decode_normals(DF df, VI packed, VF& nx, VF& ny, VF& nz) {
   nx = nx * inv_length, ny = ny * inv_length, nz = nz * inv_length;
 }
 
+// thickness_weight (variant.h) on lanes: 1 up to the assumed depth of the solid behind its
+// surface, fading to 0 at twice that; `inv_thickness` is 1 / that depth.
+template <class VF>
+HWY_INLINE VF thickness_weight_lanes(VF depth_behind_surface, VF inv_thickness) {
+  namespace hn = hwy::HWY_NAMESPACE;
+  const hn::DFromV<VF> df;
+  return hn::Min(
+      hn::Set(df, 1.0f),
+      hn::Max(hn::Zero(df), hn::NegMulAdd(depth_behind_surface, inv_thickness, hn::Set(df, 2.0f))));
+}
+
 // The camera model on lanes, its constants broadcast once per row: CameraModel::project (the
 // call operator) and the rays through pixel centres (pixel_ray).
 template <class VF>

@@ -309,9 +309,7 @@ HWY_INLINE VF solid_weight_lanes(const HemisphereRowArgs& a, VI index, M hidden,
     inv_depth_of_solid =
         hn::IfThenElse(known, one / hn::IfThenElse(known, measured, one), inv_thickness);
   }
-  const VF thick =
-      hn::Min(one, hn::Max(zero, hn::Set(df, 2.0f) - (depth - entry) * inv_depth_of_solid));
-  return hn::IfThenElse(closed, one, thick);
+  return hn::IfThenElse(closed, one, thickness_weight_lanes(depth - entry, inv_depth_of_solid));
 }
 
 // Hemisphere::beyond_frame on the lanes of `outside`, samples (sx, sy, sz) in front of the camera
@@ -365,9 +363,8 @@ HWY_INLINE VF beyond_frame_lanes(const HemisphereRowArgs& a, const LaneProjectio
   counts = hn::And(counts, hn::And(hn::Gt(ahead, zero), hn::Gt(level, plane_level)));
   if (hn::AllFalse(df, counts)) return zero;
   if (a.extra_layers == 0) {  // the visible surface, within the assumed thickness
-    return hn::IfThenElseZero(
-        counts, hn::Min(one, hn::Max(zero, hn::NegMulAdd(ahead, hn::Set(df, 1.0f / a.thickness),
-                                                         hn::Set(df, 2.0f)))));
+    return hn::IfThenElseZero(counts,
+                              thickness_weight_lanes(ahead, hn::Set(df, 1.0f / a.thickness)));
   }
   // The border pixel's hits go on beyond the frame too: the sample, `ahead` behind the plane,
   // stands where a point that far behind the border pixel's visible surface stands among them.
@@ -389,7 +386,6 @@ HWY_NOINLINE void hemisphere_row_of(const HemisphereRowArgs& a, int y, int x0, i
   const CameraIntrinsics& cam = a.camera;
   const VF inf = hn::Set(df, std::numeric_limits<float>::infinity());
   const VF zero = hn::Zero(df), one = hn::Set(df, 1.0f), half = hn::Set(df, 0.5f);
-  const VF two = hn::Set(df, 2.0f);
   const VF inv_thickness = hn::Set(df, 1.0f / a.thickness);
   const VF radius = hn::Set(df, a.radius);
   const LaneProjection<VF> project(cam, a.width, a.height);
@@ -513,7 +509,7 @@ HWY_NOINLINE void hemisphere_row_of(const HemisphereRowArgs& a, int y, int x0, i
               hn::And(hn::And(in_image, hn::Lt(qd, inf)), hn::Gt(level, plane_level));
           const VF covered =
               hn::Min(one, hn::Max(zero, cone_part_lanes(behind, hn::LoadU(df, cone))));
-          const VF thick = hn::Min(one, hn::Max(zero, two - behind * inv_thickness));
+          const VF thick = thickness_weight_lanes(behind, inv_thickness);
           blocked = hn::Max(blocked, hn::IfThenElseZero(above, covered * thick));
           // Hidden beyond that solid's reach: the surface beyond the nearest silhouette, carried
           // on behind the object (Frame::carried_depth), occludes within the assumed thickness
@@ -537,7 +533,7 @@ HWY_NOINLINE void hemisphere_row_of(const HemisphereRowArgs& a, int y, int x0, i
                     cnx, cny, cnz);
                 const VF side =
                     hn::MulAdd(px - cxv, cnx, hn::MulAdd(py - cyv, cny, (pz - czv) * cnz));
-                const VF carried_weight = hn::Min(one, hn::Max(zero, two - past * inv_thickness));
+                const VF carried_weight = thickness_weight_lanes(past, inv_thickness);
                 blocked = hn::Max(blocked, hn::IfThenElseZero(hn::And(carries, hn::Gt(side, zero)),
                                                               carried_weight));
               }

@@ -184,7 +184,7 @@ void volumetric_row(const VolumetricRowArgs& a, int y, int x0, int x1, float* ou
     };
     // add_ray(): the ray's volume in the sphere and the part behind the depth buffer.
     auto add = [&](VF enter, VF leave, VF surface, VF weight, VF& solid, VF& total) {
-      const VF fade = hn::Min(one, hn::Max(zero, two - (enter - surface) * inv_thickness));
+      const VF fade = thickness_weight_lanes(enter - surface, inv_thickness);
       const VF w = weight * hn::IfThenElse(hn::Lt(surface, enter), fade, one);
       const VF from = hn::Min(hn::Max(surface, enter), leave);
       if (ortho) {
