@@ -45,8 +45,8 @@ NODE_DESCRIPTIONS = {
                        "still always is)",
     "edge_coverage": "Beauty: where one surface passes in front of another, the AO mixes the "
                      "two surfaces' AO by the share of the pixel each covers, read from the "
-                     "Image's colours (the last render's) and the Normal pass, as Cycles' AO pass "
-                     "does; none for an "
+                     "Image's colours (the last render's), the Normal pass or the Depth's "
+                     "staircase, as Cycles' AO pass does; none for an "
                      "Image whose edges are not the Depth's (blurred before the node: Defocus, "
                      "or depth of field and motion blur rendered into it)",
 }

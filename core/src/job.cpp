@@ -575,12 +575,13 @@ void Job::run() {
 
   const float radius = static_cast<float>(v.get_float("radius"));
   const Denoiser denoiser(seen, denoise_mode(v.get_string("denoise")), radius);
-  const float filter_weight = pixel_filter_weight(v.get_float("pixel_filter"));
+  const float filter_sigma = static_cast<float>(v.get_float("pixel_filter"));
+  const float filter_weight = pixel_filter_weight(filter_sigma);
   // The colours that tell each surface's share of an edge pixel: the beauty's, unless the front
   // end gave others (its beauty is not the picture).
   const ImageView& edge_colours = edge_colours_.attached() ? edge_colours_ : beauty_;
-  const bool edges_from_beauty =
-      v.get_string("edge_coverage") == "beauty" && edge_colours.attached();
+  // Mixed by the colours where given, by the normals where given, else by the depth's staircase.
+  const bool edges_from_beauty = v.get_string("edge_coverage") == "beauty";
   // A frame of a sequence (frame >= 0) averages the frames before it that this job computed.
   const int frame_number = v.get_int("frame");
   temporal_.begin(frame_number, frame_number >= 0 ? v.get_int("temporal_frames") : 1, camera,
@@ -639,7 +640,7 @@ void Job::run() {
       }
       if (edges_from_beauty) {
         mix_edges_by_beauty(frame, edge_colours, normal_, dx, dy, around, resolved.data(), t,
-                            filter_weight, denoised.data());
+                            filter_weight, filter_sigma, denoised.data());
       }
     } else {
       resolve(t, denoised.data());

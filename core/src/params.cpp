@@ -145,20 +145,21 @@ const std::vector<Param>& params() {
       float_param(kInput, "background_depth", 1e9, 0.0, kInf, "scene units",
                   "depths at or beyond this are background (Blender writes 1e10)"),
       string_param(kInput, "edge_coverage", "beauty", "none|beauty",
-                   "beauty: at a depth edge, where the \"beauty\" image is attached and the "
-                   "edge's pixels show mixes of the two surfaces, in their colours (which must "
-                   "differ enough) or in their normals (where the \"normal\" image is attached "
-                   "and filtered over the pixel like the beauty, and the two surfaces' normals "
-                   "differ enough), the pixel's AO is the two surfaces' AO (each through the pixel "
-                   "filter) mixed by the share of the pixel each covers, read from the "
-                   "anti-aliased beauty (or the \"edge_colours\" image in its place) or Normal "
-                   "pass, as a renderer's AO pass mixes them (the Depth pass holds one surface, "
-                   "at the pixel's centre: the other gets at most half; where colours and normals "
-                   "both read a mix, the smaller share); a pixel whose normal is no mix of the two "
-                   "surfaces' holds a third and keeps the pixel filter; elsewhere, and without a "
-                   "beauty, the pixel filter alone; not for a beauty whose edges are not the "
-                   "depth's (depth of field or motion blur rendered into it). none: the pixel "
-                   "filter alone"),
+                   "beauty: at a depth edge the pixel's AO is the two surfaces' AO (each through "
+                   "the pixel filter) mixed by the share of the pixel each covers, as a "
+                   "renderer's AO pass mixes them (the Depth pass holds one surface, at the "
+                   "pixel's centre: the other gets at most half), read where the edge's pixels "
+                   "show mixes of the two surfaces in their colours (the \"beauty\" image, or "
+                   "the \"edge_colours\" image in its place; the colours must differ enough) or "
+                   "in their normals (the \"normal\" image with a beauty, filtered over the "
+                   "pixel like the beauty; the two surfaces' normals must differ enough; where "
+                   "both read a mix, "
+                   "the smaller share), else from the depth's staircase (a run of edge pixels "
+                   "that steps one pixel toward each surface at its two ends places a straight "
+                   "silhouette inside the pixels); a pixel whose normal is no mix of the two "
+                   "surfaces' holds a third and keeps the pixel filter, as does any edge none of "
+                   "these reads; not for a beauty whose edges are not the depth's (depth of "
+                   "field or motion blur rendered into it). none: the pixel filter alone"),
       // --- camera (Blender's bpy.types.Camera names) ---
       string_param(kCamera, "camera_type", "PERSP", "PERSP|ORTHO",
                    "perspective or orthographic camera"),

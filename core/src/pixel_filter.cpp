@@ -213,11 +213,89 @@ bool normal_is_mix(const Vec3& m, const Vec3& a, const Vec3& b) {
   return dot(off, off) <= kEdgeNormalTolerance * kEdgeNormalTolerance;
 }
 
+// Whether pixel a and its neighbour a + s straddle the edge followed so far: both geometry, a on
+// the surface whose depth next to it is `own`, a + s on the one at `other`, a jump between them
+// and a the nearer exactly when the edge's first pixel was. Moves own and other on to theirs.
+bool continues_edge(const Frame& frame, int ax, int ay, int sx, int sy, bool own_nearer, float& own,
+                    float& other) {
+  const int bx = ax + sx, by = ay + sy;
+  if (ax < 0 || ay < 0 || bx < 0 || by < 0 || ax >= frame.width() || bx >= frame.width() ||
+      ay >= frame.height() || by >= frame.height() || !frame.is_geometry(ax, ay) ||
+      !frame.is_geometry(bx, by)) {
+    return false;
+  }
+  const float a = frame.depth(ax, ay), b = frame.depth(bx, by);
+  if (depth_jump(a, own) || depth_jump(b, other) || !depth_jump(a, b) || (a < b) != own_nearer) {
+    return false;
+  }
+  own = a, other = b;
+  return true;
+}
+
+// Pixel p's share of its own surface read from the staircase the edge between p = (x, y) and its
+// neighbour n = p + (sx, sy) draws in the depth image (morphological anti-aliasing, Reshetov
+// 2009). The Depth pass holds the surface at each pixel's centre, so a straight silhouette at a
+// slant draws runs of pixels along the edge, each one pixel over from the last; the line crosses
+// the row of centres where a run steps. Only a run whose two ends step opposite ways (a Z: the
+// edge goes on one pixel toward n at one end and toward p at the other) is read: the line then
+// goes from half a pixel on p's side at one end to half a pixel on n's at the other, and its
+// place at p gives p's share through the pixel filter (Gaussian of standard deviation sigma;
+// without one, p's square). A run that steps the same way at both ends (the top of a curve)
+// or at one end only (an edge that ends at a corner) does not say where the line lies: false,
+// as for a run longer than kStaircaseReach each way.
+bool own_share_from_staircase(const Frame& frame, int x, int y, int sx, int sy, float sigma,
+                              float& share) {
+  const int tx = sy != 0 ? 1 : 0, ty = sx != 0 ? 1 : 0;  // along the edge
+  const bool own_nearer = frame.depth(x, y) < frame.depth(x + sx, y + sy);
+  int steps[2] = {0, 0}, reach[2] = {0, 0};  // before p (k < 0) and after it (k > 0)
+  for (int side = 0; side < 2; ++side) {
+    const int dir = side == 0 ? -1 : 1;
+    float own = frame.depth(x, y), other = frame.depth(x + sx, y + sy);
+    int k = 1;
+    while (k <= kStaircaseReach && continues_edge(frame, x + dir * k * tx, y + dir * k * ty, sx, sy,
+                                                  own_nearer, own, other)) {
+      ++k;
+    }
+    if (k > kStaircaseReach) return false;
+    reach[side] = k - 1;
+    // The first pixel e past the run, on p's side of the edge.
+    const int ex = x + dir * k * tx, ey = y + dir * k * ty;
+    if (ex < 0 || ey < 0 || ex >= frame.width() || ey >= frame.height() ||
+        !frame.is_geometry(ex, ey)) {
+      return false;
+    }
+    const float e = frame.depth(ex, ey);
+    float step_own = e, step_other = other;
+    if (!depth_jump(e, own) &&
+        continues_edge(frame, ex + sx, ey + sy, sx, sy, own_nearer, step_own, step_other)) {
+      steps[side] = 1;  // p's surface covers e and the pixel beyond it toward n
+    }
+    step_own = own, step_other = other;
+    if (continues_edge(frame, ex - sx, ey - sy, sx, sy, own_nearer, step_own, step_other)) {
+      steps[side] = -1;  // n's surface covers e: the edge steps toward p
+    }
+  }
+  if (steps[0] == 0 || steps[0] != -steps[1]) return false;
+  // The line's offset from the p/n boundary toward n at p's place along the run, from half a
+  // pixel either way at the run's ends (k = -before - 0.5 and k = after + 0.5).
+  const float from = -float(reach[0]) - 0.5f, to = float(reach[1]) + 0.5f;
+  const float at_start = 0.5f * float(steps[0]), at_end = 0.5f * float(steps[1]);
+  const float offset = at_start + (at_end - at_start) * (0.0f - from) / (to - from);
+  // p's centre lies half a pixel from the boundary, on its own side; the Gaussian's share
+  // across the slanted line goes by the distance square to it.
+  const float distance = offset + 0.5f;
+  const float slope = (at_end - at_start) / (to - from);
+  share = sigma > 0.0f
+              ? 0.5f * std::erfc(-distance / (sigma * std::sqrt(2.0f * (1.0f + slope * slope))))
+              : std::min(1.0f, std::max(0.0f, distance + 0.5f));
+  return true;
+}
+
 }  // namespace
 
 void mix_edges_by_beauty(const Frame& frame, const ImageView& beauty, const ImageView& normal,
                          int dx, int dy, const Tile& around, const float* source, const Tile& t,
-                         float weight, float* out) {
+                         float weight, float sigma, float* out) {
   const auto normal_at = [&](int x, int y) {
     const float* n = normal.pixel(x, y);
     return Vec3{n[0], n[1], n[2]};
@@ -286,8 +364,10 @@ void mix_edges_by_beauty(const Frame& frame, const ImageView& beauty, const Imag
                               beauty_colour(beauty, x - dx, y - dy, mixed) &&
                               beauty_colour(beauty, nx - dx, ny - dy, neighbour) &&
                               own_share_from_colours(own, other, mixed, neighbour, colour_share);
+      // The normals are read only along with colours: alone (no beauty) they made the layered
+      // AO on camera moves worse (docs/variants.md, "Coverage from the depth's staircase").
       bool by_normals = false;
-      if (normal.attached()) {
+      if (normal.attached() && beauty.attached()) {
         const Vec3 own_normal = normal_at(x - sx, y - sy),
                    other_normal = normal_at(nx + sx, ny + sy);
         const Vec3 mixed_normal = normal_at(x, y);
@@ -299,14 +379,19 @@ void mix_edges_by_beauty(const Frame& frame, const ImageView& beauty, const Imag
             own_share_from_normals(own_normal, normal_at(ox, oy), other_normal, normal_at(fx, fy),
                                    mixed_normal, normal_at(nx, ny), normal_share);
       }
-      if (!by_colours && !by_normals) continue;
+      float staircase_share = 0.0f;
+      const bool by_staircase =
+          !by_colours && !by_normals &&
+          own_share_from_staircase(frame, x, y, sx, sy, sigma, staircase_share);
+      if (!by_colours && !by_normals && !by_staircase) continue;
       // Where both read a mix, as little of one as either reads (a shadow's gradient makes the
       // colours read more of the other surface, a crease in it the normals). The Depth pass's
       // sample at p's centre is on p's surface: for a straight edge through a symmetric pixel
       // filter that side holds at least half of the pixel.
       float beta = by_colours && by_normals ? std::max(colour_share, normal_share)
                    : by_colours             ? colour_share
-                                            : normal_share;
+                   : by_normals             ? normal_share
+                                            : staircase_share;
       beta = std::min(1.0f, std::max(kEdgeMinOwnShare, beta));
       // Each surface's AO through the pixel filter, over the pixels around p on that surface
       // (without the filter, p's and n's own).

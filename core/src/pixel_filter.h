@@ -37,25 +37,31 @@ Tile pixel_filter_source(const Frame& frame, const Tile& t);
 //   |B|), and the colours C of p and N of n lie on the line through B and A, N between them (each
 //   within kEdgeColourTolerance x |A - B| of it; else A and B are not the colours of p's and n's
 //   surfaces, e.g. a highlight on n): beta = (C - B) . (A - B) / |A - B|^2;
-// - normals, where the Normal pass is given (`normal`, the depth image's size: frame pixel (x, y)
-//   is its pixel (x, y)) and filtered over the pixel like the beauty: the same with the normals,
+// - normals, where the Normal pass is given with a beauty (`normal`, the depth image's size:
+//   frame pixel (x, y) is its pixel (x, y)) and filtered over the pixel like the beauty: the same
+//   with the normals,
 //   where the two surfaces' differ by kEdgeNormalContrast or more, each is steady one pixel
 //   further out (within kEdgeNormalSteady) and p or n shows a mix (by more than
-//   kEdgeNormalMixShown; a pass of pixel-centre normals shows none).
-// Where both read a mix beta is the larger (the smaller share of the other surface), and never
-// under kEdgeMinOwnShare (p's centre is on its own surface); out(p) = beta AO_p + (1 - beta) AO_n,
-// where AO_p and AO_n are the pixel filter (weight w) over the pixels around p on p's and on n's
-// surface alone, from `source` (tile `around`, as for pixel_filter). Where the Normal pass is
-// given, p's normal must also be a mix of the normals beyond p and beyond n (within
+//   kEdgeNormalMixShown; a pass of pixel-centre normals shows none);
+// - where neither reads a mix (no beauty, one colour, pixel-centre normals), the depth's
+//   staircase: along a straight slanted silhouette the Depth pass draws runs of pixels, and a run
+//   that steps one pixel toward n at one end and toward p at the other (followed up to
+//   kStaircaseReach pixels each way) places the line between them; beta is the share of the
+//   pixel filter (standard deviation `sigma`; 0: p's square) on p's side of it.
+// Where both colours and normals read a mix beta is the larger (the smaller share of the other
+// surface), and never under kEdgeMinOwnShare (p's centre is on its own surface); out(p) = beta AO_p
+// + (1 - beta) AO_n, where AO_p and AO_n are the pixel filter (weight w) over the pixels around p
+// on p's and on n's surface alone, from `source` (tile `around`, as for pixel_filter). Where the
+// Normal pass is given, p's normal must also be a mix of the normals beyond p and beyond n (within
 // kEdgeNormalTolerance of the segment between them): else p holds a third surface too small to
 // show elsewhere (the top of a board seen at a grazing angle, a sliver in a pixel), whose colour
 // the two-colour model would read as one of the two. Elsewhere out is left as it is. `beauty`
 // has the output window's size: frame pixel (x, y) is its pixel (x - dx, y - dy); its first
 // three channels are read (one channel: grey). A jump to the sky does not count (the normal
-// pass's coverage handles it).
+// pass's coverage handles it). `beauty` and `normal` may be empty (not attached).
 void mix_edges_by_beauty(const Frame& frame, const ImageView& beauty, const ImageView& normal,
                          int dx, int dy, const Tile& around, const float* source, const Tile& t,
-                         float weight, float* out);
+                         float weight, float sigma, float* out);
 constexpr float kEdgeDepthJump = 0.05f;
 constexpr float kEdgeColourContrast = 0.5f;
 constexpr float kEdgeColourTolerance = 0.25f;
@@ -64,5 +70,6 @@ constexpr float kEdgeNormalContrast = 0.15f;
 constexpr float kEdgeNormalSteady = 0.05f;
 constexpr float kEdgeNormalMixShown = 0.02f;
 constexpr float kEdgeMinOwnShare = 0.5f;
+constexpr int kStaircaseReach = 16;
 
 }  // namespace ssao

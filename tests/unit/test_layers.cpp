@@ -705,11 +705,26 @@ TEST(Layers, ABoxCornerDrawsNoWedgeOnTheFloorBesideIt) {
     const double v = std::max(std::fabs(dot(p - base, side_b)) - 0.5, 0.0);
     return std::sqrt(u * u + v * v);
   };
-  const Scored scored = score_where(s, solids, 256, 8, 8, 1, [&](const V3& p) {
+  Scored scored = score_where(s, solids, 256, 8, 8, 1, [&](const V3& p) {
     if (std::fabs(dot(p - contact, up)) > 1e-6) return false;
     const double d = from_foot(p);
     return d > 0.1 && d < 2.0;
   });
+  // Nor the pixels on the cube's silhouette: there the AO mixes both surfaces, as a renderer's
+  // anti-aliased pass does (pixel filter, edge coverage), where this reference holds the floor's
+  // at the pixel's centre.
+  Scored off_silhouette;
+  for (size_t k = 0; k < scored.pixels.size(); ++k) {
+    const size_t i = scored.pixels[k];
+    bool jump = false;
+    for (const size_t n : {i - 1, i + 1, i - s.width, i + s.width}) {
+      jump = jump || std::fabs(s.depth[i] - s.depth[n]) > 0.05f * std::min(s.depth[i], s.depth[n]);
+    }
+    if (jump) continue;
+    off_silhouette.pixels.push_back(i);
+    off_silhouette.reference.push_back(scored.reference[k]);
+  }
+  scored = off_silhouette;
   ASSERT_GT(scored.pixels.size(), 5000u);
   const std::vector<float> ao = layered_ao(s, cam, true);
   const Error three = error_against(ao, scored.reference, scored.pixels);
@@ -722,7 +737,9 @@ TEST(Layers, ABoxCornerDrawsNoWedgeOnTheFloorBesideIt) {
       "%+.4f; %d px more than 0.08 darker than ray-traced\n",
       three.count, three.rmse, three.bias, dark);
   // Before the crossing test asked the shown surface's normal: RMSE 0.0139, 32 px more than
-  // 0.08 darker (the wedge); now 0.0134 and 1.
+  // 0.08 darker (the wedge); then 0.0134 and 1. Since the edge coverage reads the depth's
+  // staircase the silhouette's 142 px are left out (with them 6 px, mixed with the cube's AO):
+  // 0.0126 and 1.
   EXPECT_LE(dark, 4);
   EXPECT_LT(three.rmse, 0.016);
 }
