@@ -277,7 +277,7 @@ bool own_share_from_staircase(const Frame& frame, int x, int y, int sx, int sy, 
   }
   if (steps[0] == 0 || steps[0] != -steps[1]) return false;
   // The line's offset from the p/n boundary toward n at p's place along the run, from half a
-  // pixel either way at the run's ends (k = -before - 0.5 and k = after + 0.5).
+  // pixel either way at the run's ends (k = -reach[0] - 0.5 and k = reach[1] + 0.5).
   const float from = -float(reach[0]) - 0.5f, to = float(reach[1]) + 0.5f;
   const float at_start = 0.5f * float(steps[0]), at_end = 0.5f * float(steps[1]);
   const float offset = at_start + (at_end - at_start) * (0.0f - from) / (to - from);
