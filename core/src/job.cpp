@@ -580,7 +580,7 @@ void Job::run() {
   // The colours that tell each surface's share of an edge pixel: the beauty's, unless the front
   // end gave others (its beauty is not the picture).
   const ImageView& edge_colours = edge_colours_.attached() ? edge_colours_ : beauty_;
-  // Mixed by the colours where given, by the normals where given, else by the depth's staircase.
+  // Mixed by the colours where given (and the normals with them), else by the depth's staircase.
   const bool edges_from_beauty = v.get_string("edge_coverage") == "beauty";
   // A frame of a sequence (frame >= 0) averages the frames before it that this job computed.
   const int frame_number = v.get_int("frame");
