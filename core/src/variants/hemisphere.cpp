@@ -259,8 +259,7 @@ HWY_INLINE VF between_lanes(const HemisphereRowArgs& a, const LaneProjection<VF>
   const VF covered =
       hn::Min(one, hn::Max(zero, hn::Max(cone_part_lanes(behind * scale, half_inv_width),
                                          end_part_lanes(a, past_end))));
-  const VF thick = hn::Min(one, hn::Max(zero, hn::NegMulAdd(behind, hn::Set(df, 1.0f / a.thickness),
-                                                            hn::Set(df, 2.0f))));
+  const VF thick = thickness_weight_lanes(behind, hn::Set(df, 1.0f / a.thickness));
   return hn::IfThenElseZero(inside, covered * hn::IfThenElse(hn::Lt(next, zero), one, thick));
 }
 
