@@ -581,7 +581,7 @@ void Job::run() {
   // end gave others (its beauty is not the picture).
   const ImageView& edge_colours = edge_colours_.attached() ? edge_colours_ : beauty_;
   // Mixed by the colours where given (and the normals with them), else by the depth's staircase.
-  const bool edges_from_beauty = v.get_string("edge_coverage") == "beauty";
+  const bool mix_edges = v.get_string("edge_coverage") == "beauty";
   // A frame of a sequence (frame >= 0) averages the frames before it that this job computed.
   const int frame_number = v.get_int("frame");
   temporal_.begin(frame_number, frame_number >= 0 ? v.get_int("temporal_frames") : 1, camera,
@@ -625,7 +625,7 @@ void Job::run() {
     };
     if (sky) {
       std::fill(denoised.begin(), denoised.end(), 1.0f);
-    } else if (filter_weight > 0.0f || edges_from_beauty) {
+    } else if (filter_weight > 0.0f || mix_edges) {
       const Tile around = pixel_filter_source(frame, t);
       ScratchVector<float> resolved(size_t(around.x1 - around.x0) * size_t(around.y1 - around.y0));
       resolve(around, resolved.data());
@@ -638,7 +638,7 @@ void Job::run() {
                       t.x1 - t.x0, denoised.data() + size_t(y - t.y0) * size_t(t.x1 - t.x0));
         }
       }
-      if (edges_from_beauty) {
+      if (mix_edges) {
         mix_edges_by_beauty(frame, edge_colours, normal_, dx, dy, around, resolved.data(), t,
                             filter_weight, filter_sigma, denoised.data());
       }

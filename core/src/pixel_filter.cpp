@@ -213,17 +213,18 @@ bool normal_is_mix(const Vec3& m, const Vec3& a, const Vec3& b) {
   return dot(off, off) <= kEdgeNormalTolerance * kEdgeNormalTolerance;
 }
 
+// Whether pixel (x, y) lies in the frame and shows geometry.
+bool geometry_at(const Frame& frame, int x, int y) {
+  return x >= 0 && y >= 0 && x < frame.width() && y < frame.height() && frame.is_geometry(x, y);
+}
+
 // Whether pixel a and its neighbour a + s straddle the edge followed so far: both geometry, a on
 // the surface whose depth next to it is `own`, a + s on the one at `other`, a jump between them
 // and a the nearer exactly when the edge's first pixel was. Moves own and other on to theirs.
 bool continues_edge(const Frame& frame, int ax, int ay, int sx, int sy, bool own_nearer, float& own,
                     float& other) {
   const int bx = ax + sx, by = ay + sy;
-  if (ax < 0 || ay < 0 || bx < 0 || by < 0 || ax >= frame.width() || bx >= frame.width() ||
-      ay >= frame.height() || by >= frame.height() || !frame.is_geometry(ax, ay) ||
-      !frame.is_geometry(bx, by)) {
-    return false;
-  }
+  if (!geometry_at(frame, ax, ay) || !geometry_at(frame, bx, by)) return false;
   const float a = frame.depth(ax, ay), b = frame.depth(bx, by);
   if (depth_jump(a, own) || depth_jump(b, other) || !depth_jump(a, b) || (a < b) != own_nearer) {
     return false;
@@ -260,10 +261,7 @@ bool own_share_from_staircase(const Frame& frame, int x, int y, int sx, int sy, 
     reach[side] = k - 1;
     // The first pixel e past the run, on p's side of the edge.
     const int ex = x + dir * k * tx, ey = y + dir * k * ty;
-    if (ex < 0 || ey < 0 || ex >= frame.width() || ey >= frame.height() ||
-        !frame.is_geometry(ex, ey)) {
-      return false;
-    }
+    if (!geometry_at(frame, ex, ey)) return false;
     const float e = frame.depth(ex, ey);
     float step_own = e, step_other = other;
     if (!depth_jump(e, own) &&
@@ -304,9 +302,6 @@ void mix_edges_by_beauty(const Frame& frame, const ImageView& beauty, const Imag
   const auto source_at = [&](int x, int y) {
     return source[size_t(y - around.y0) * size_t(around.x1 - around.x0) + size_t(x - around.x0)];
   };
-  const auto inside = [&](int x, int y) {
-    return x >= 0 && y >= 0 && x < frame.width() && y < frame.height() && frame.is_geometry(x, y);
-  };
   // Jumps to the right and below of the pixels in rows t.y0 - 1 .. t.y1 - 1 and columns
   // t.x0 - 1 .. t.x1 - 1 (clipped to the frame): a pixel is a candidate when it, its left or its
   // upper neighbour has a flag.
@@ -344,7 +339,7 @@ void mix_edges_by_beauty(const Frame& frame, const ImageView& beauty, const Imag
       int sx = 0, sy = 0;
       float largest = 0.0f;
       for (const auto& s : kFourNeighbours) {
-        if (!inside(x + s[0], y + s[1])) continue;
+        if (!geometry_at(frame, x + s[0], y + s[1])) continue;
         const float other = frame.depth(x + s[0], y + s[1]);
         const float jump = std::fabs(depth - other) / std::min(depth, other);
         if (depth_jump(depth, other) && jump > largest) largest = jump, sx = s[0], sy = s[1];
@@ -352,7 +347,7 @@ void mix_edges_by_beauty(const Frame& frame, const ImageView& beauty, const Imag
       if (largest == 0.0f) continue;
       const int nx = x + sx, ny = y + sy;
       // The pixels beyond either side must lie on the same surfaces as p and n.
-      if (!inside(x - sx, y - sy) || !inside(nx + sx, ny + sy) ||
+      if (!geometry_at(frame, x - sx, y - sy) || !geometry_at(frame, nx + sx, ny + sy) ||
           depth_jump(depth, frame.depth(x - sx, y - sy)) ||
           depth_jump(frame.depth(nx, ny), frame.depth(nx + sx, ny + sy))) {
         continue;
