@@ -309,16 +309,7 @@ struct SlantedBoard {
     solids = {board, {{{0, 0, -wall}, {0, 0, 1}}}};
     behind = 0.5 * (5.3 + wall);
     s = ray_cast(cam, solids);
-    // Pixels with a depth jump of more than 5 % to a 4-neighbour (both surfaces geometry).
-    edge.assign(s.depth.size(), 0);
-    for (int y = 1; y + 1 < s.height; ++y) {
-      for (int x = 1; x + 1 < s.width; ++x) {
-        for (const auto& [dx, dy] : {std::pair{1, 0}, {-1, 0}, {0, 1}, {0, -1}}) {
-          const float d = s.depth[index(x, y)], n = s.depth[index(x + dx, y + dy)];
-          if (std::fabs(d - n) > 0.05f * std::min(d, n)) edge[index(x, y)] = 1;
-        }
-      }
-    }
+    edge = depth_jump_pixels(s);
     sub_ao.assign(s.depth.size() * kSub * kSub, -1.0);
   }
   size_t index(int x, int y) const { return size_t(y) * s.width + x; }
