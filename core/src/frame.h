@@ -153,16 +153,18 @@ class Frame {
   // point lies behind the ray's last known hit.
   float solid_entry(int x, int y, float depth, bool& closed, bool* past_last = nullptr) const;
 
-  // With extra layers, per pixel: how deep the solid entered at the ray's last known hit is,
-  // when that hit is a front face hidden behind the visible surface and no later hit closes it
-  // (a column behind a fence post whose back would be hit 4), as measured where a neighbour
-  // within kThicknessSearch pixels sees a surface at that depth with its back face; 0 where
-  // nothing says (the caller's assumed thickness applies). Null without extra layers.
+  // Per pixel: how deep the solid entered at the ray's last known hit is; 0 where nothing says
+  // (the caller's assumed thickness applies). With extra layers, where that hit is a front face
+  // hidden behind the visible surface and no later hit closes it (a column behind a fence post
+  // whose back would be hit 4), as measured where a neighbour within kThicknessSearch pixels
+  // sees a surface at that depth with its back face. Without them the last hit is the visible
+  // surface: on something narrow across its row (a post), a depth taken from its width
+  // (measure_post_thickness), an upper bound on the assumed thickness.
   const float* last_thickness_plane() const {
-    return extra_layers_ > 0 ? last_thickness_.data() : nullptr;
+    return last_thickness_.empty() ? nullptr : last_thickness_.data();
   }
   float last_thickness(int x, int y) const {
-    return extra_layers_ > 0 ? last_thickness_[index(x, y)] : 0.0f;
+    return last_thickness_.empty() ? 0.0f : last_thickness_[index(x, y)];
   }
   static constexpr int kThicknessSearch = 8;
 
@@ -221,6 +223,7 @@ class Frame {
 
   // Fills last_thickness_ from the finished depth and layer planes.
   void infer_last_thickness(TilePool& pool, Progress& progress);
+  void measure_post_thickness(TilePool& pool, Progress& progress);
   // Fills plane_distance_scale_ from the finished depth and normal planes.
   void measure_plane_distance_scale(TilePool& pool, Progress& progress);
   void plane_distance_scale_row(int x0, int count, int y, float* out) const;

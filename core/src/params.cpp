@@ -95,7 +95,8 @@ const std::vector<Param>& params() {
           kAo, "thickness", 0.5, 0.01, 100.0, "fraction of radius",
           "assumed thickness of surfaces: horizon: an occluder spans this far behind the visible "
           "surface; hemisphere: a sample this far behind the visible surface counts fully, "
-          "fading out at twice the distance (range check against halos); volumetric: a ray "
+          "fading out at twice the distance (range check against halos; without extra layers "
+          "a post's depth taken from its width where that is less); volumetric: a ray "
           "whose visible surface is this far in front of the sphere counts fully, fading out "
           "at twice the distance"),
       string_param(kAo, "sphere_mode", "normalized", "normalized|classic",

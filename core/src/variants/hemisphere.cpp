@@ -270,6 +270,20 @@ HWY_INLINE VF between_lanes(const HemisphereRowArgs& a, const LaneProjection<VF>
 // Returns how much that solid occludes the point: 1 inside a solid a back face closes, else by
 // the solid's thickness (measured beside the foreground for the ray's last hit,
 // Frame::last_thickness, else assumed).
+// Without extra layers: 1 / the depth of the visible surface's solid at pixel `index`, the
+// assumed thickness or, where the frame measured a post there (Frame::last_thickness), that if
+// less.
+template <class VF, class VI>
+HWY_INLINE VF inv_visible_thickness_lanes(const HemisphereRowArgs& a, VI index) {
+  namespace hn = hwy::HWY_NAMESPACE;
+  const hn::DFromV<VF> df;
+  const VF measured = hn::GatherIndex(df, a.last_thickness, index);
+  const auto known = hn::Gt(measured, hn::Zero(df));
+  return hn::Max(hn::Set(df, 1.0f / a.thickness),
+                 hn::IfThenElseZero(known, hn::Set(df, 1.0f) /
+                                               hn::IfThenElse(known, measured, hn::Set(df, 1.0f))));
+}
+
 template <class M, class VF, class VI>
 HWY_INLINE VF solid_weight_lanes(const HemisphereRowArgs& a, VI index, M hidden, VF qd, VF depth,
                                  VF& entry, M& entered, M& closed) {
@@ -361,9 +375,9 @@ HWY_INLINE VF beyond_frame_lanes(const HemisphereRowArgs& a, const LaneProjectio
   const VF level = hn::MulAdd(ex, gx, hn::MulAdd(ey, gy, ez * gz));
   counts = hn::And(counts, hn::And(hn::Gt(ahead, zero), hn::Gt(level, plane_level)));
   if (hn::AllFalse(df, counts)) return zero;
-  if (a.extra_layers == 0) {  // the visible surface, within the assumed thickness
-    return hn::IfThenElseZero(counts,
-                              thickness_weight_lanes(ahead, hn::Set(df, 1.0f / a.thickness)));
+  if (a.extra_layers == 0) {  // the visible surface, within its solid's depth
+    return hn::IfThenElseZero(
+        counts, thickness_weight_lanes(ahead, inv_visible_thickness_lanes<VF>(a, index)));
   }
   // The border pixel's hits go on beyond the frame too: the sample, `ahead` behind the plane,
   // stands where a point that far behind the border pixel's visible surface stands among them.
@@ -496,7 +510,7 @@ HWY_NOINLINE void hemisphere_row_of(const HemisphereRowArgs& a, int y, int x0, i
           const VF qd = hn::GatherIndex(df, a.depth, index);
           // The visible surface at that pixel (Frame::position), above the tangent plane: the part
           // of the sample's cone behind it (Hemisphere::covered, by the depth difference), within
-          // the assumed thickness.
+          // its solid's depth (the assumed thickness, or a post's).
           const VF q_scale = cam.orthographic ? one : qd;
           VF ray_x, ray_y;
           project.pixel_ray(qx, qy, ray_x, ray_y);
@@ -508,7 +522,8 @@ HWY_NOINLINE void hemisphere_row_of(const HemisphereRowArgs& a, int y, int x0, i
               hn::And(hn::And(in_image, hn::Lt(qd, inf)), hn::Gt(level, plane_level));
           const VF covered =
               hn::Min(one, hn::Max(zero, cone_part_lanes(behind, hn::LoadU(df, cone))));
-          const VF thick = thickness_weight_lanes(behind, inv_thickness);
+          const VF thick =
+              thickness_weight_lanes(behind, inv_visible_thickness_lanes<VF>(a, index));
           blocked = hn::Max(blocked, hn::IfThenElseZero(above, covered * thick));
           // Hidden beyond that solid's reach: the surface beyond the nearest silhouette, carried
           // on behind the object (Frame::carried_depth), occludes within the assumed thickness
@@ -981,7 +996,11 @@ class Hemisphere final : public Variant {
     entry = f.solid_entry(qx, qy, depth, closed, &past_last);
     if (entry == Frame::kBackground) return 0.0f;
     const float measured = past_last ? f.last_thickness(qx, qy) : 0.0f;
-    return closed ? 1.0f : thickness_weight(depth - entry, measured > 0.0f ? measured : thickness_);
+    // Without extra layers the measure is a post's depth, taken where it is the less.
+    const float depth_of_solid =
+        !(measured > 0.0f) ? thickness_
+                           : (f.extra_layers() > 0 ? measured : std::min(measured, thickness_));
+    return closed ? 1.0f : thickness_weight(depth - entry, depth_of_solid);
   }
 
   static bool sides_differ(Vec3 a, Vec3 b, Vec3 q, Vec3 nq) {
