@@ -277,6 +277,7 @@ template <class VF, class VI>
 HWY_INLINE VF inv_visible_thickness_lanes(const HemisphereRowArgs& a, VI index) {
   namespace hn = hwy::HWY_NAMESPACE;
   const hn::DFromV<VF> df;
+  if (a.last_thickness == nullptr) return hn::Set(df, 1.0f / a.thickness);
   const VF measured = hn::GatherIndex(df, a.last_thickness, index);
   const auto known = hn::Gt(measured, hn::Zero(df));
   return hn::Max(hn::Set(df, 1.0f / a.thickness),
