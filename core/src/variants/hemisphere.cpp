@@ -263,13 +263,6 @@ HWY_INLINE VF between_lanes(const HemisphereRowArgs& a, const LaneProjection<VF>
   return hn::IfThenElseZero(inside, covered * hn::IfThenElse(hn::Lt(next, zero), one, thick));
 }
 
-// Frame::solid_entry on the lanes of `hidden`, points at planar depth `depth` behind the visible
-// surface (depth qd) of the pixels at `index`: walks the hits behind the visible one until the one
-// the point lies in front of. `entry`: the depth of the front face the point lies behind;
-// `entered`: it lies behind a front face at all; `closed`: a back face follows it on the ray.
-// Returns how much that solid occludes the point: 1 inside a solid a back face closes, else by
-// the solid's thickness (measured beside the foreground for the ray's last hit,
-// Frame::last_thickness, else assumed).
 // Without extra layers: 1 / the depth of the visible surface's solid at pixel `index`, the
 // assumed thickness or, where the frame measured a post there (Frame::last_thickness), that if
 // less.
@@ -285,6 +278,13 @@ HWY_INLINE VF inv_visible_thickness_lanes(const HemisphereRowArgs& a, VI index) 
                                                hn::IfThenElse(known, measured, hn::Set(df, 1.0f))));
 }
 
+// Frame::solid_entry on the lanes of `hidden`, points at planar depth `depth` behind the visible
+// surface (depth qd) of the pixels at `index`: walks the hits behind the visible one until the one
+// the point lies in front of. `entry`: the depth of the front face the point lies behind;
+// `entered`: it lies behind a front face at all; `closed`: a back face follows it on the ray.
+// Returns how much that solid occludes the point: 1 inside a solid a back face closes, else by
+// the solid's thickness (measured beside the foreground for the ray's last hit,
+// Frame::last_thickness, else assumed).
 template <class M, class VF, class VI>
 HWY_INLINE VF solid_weight_lanes(const HemisphereRowArgs& a, VI index, M hidden, VF qd, VF depth,
                                  VF& entry, M& entered, M& closed) {
