@@ -98,6 +98,12 @@ struct CarriedPlane {
   float w = 0.0f;
   uint32_t packed = 0;
 };
+
+// Whether neighbouring planar depths a and b lie on one surface: within Frame::kCarryJump of each
+// other.
+bool on_one_surface(float a, float b) {
+  return a < b * Frame::kCarryJump && b < a * Frame::kCarryJump;
+}
 }  // namespace
 
 // Per tile, each of the four walks is a scan towards the pixels from kCarrySearch pixels beyond
@@ -121,7 +127,7 @@ void Frame::find_carried_surfaces(TilePool& pool, Progress& progress) {
     if (far_side == kBackground) return plane;
     const int gx = x + dx, gy = y + dy;
     if (gx >= 0 && gy >= 0 && gx < width_ && gy < height_ &&
-        depth(gx, gy) < far_side * kCarryJump && far_side < depth(gx, gy) * kCarryJump) {
+        on_one_surface(depth(gx, gy), far_side)) {
       x = gx, y = gy;
     }
     const uint32_t packed = normal_[index(x, y)];
@@ -234,8 +240,7 @@ void Frame::measure_post_thickness(TilePool& pool, Progress& progress) {
         }
         int end = x + 1;
         float nearest = row[x], farthest = row[x];
-        while (end < width_ && row[end] != kBackground && row[end] < row[end - 1] * kCarryJump &&
-               row[end - 1] < row[end] * kCarryJump) {
+        while (end < width_ && row[end] != kBackground && on_one_surface(row[end - 1], row[end])) {
           nearest = std::min(nearest, row[end]), farthest = std::max(farthest, row[end]);
           ++end;
         }
