@@ -6,6 +6,7 @@
 // more for the surfaces carried on behind silhouettes: carried_depth_plane).
 #pragma once
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -158,13 +159,23 @@ class Frame {
   // hidden behind the visible surface and no later hit closes it (a column behind a fence post
   // whose back would be hit 4), as measured where a neighbour within kThicknessSearch pixels
   // sees a surface at that depth with its back face. Without them the last hit is the visible
-  // surface: on something narrow across its row (a post), a depth taken from its width
-  // (measure_post_thickness), an upper bound on the assumed thickness.
+  // surface, and the plane holds upper bounds on the assumed thickness: on something narrow
+  // across its row (a post), a depth taken from its width (measure_post_thickness); stored
+  // negated, how deep the face can be without showing the side face a deeper solid would
+  // (bound_by_side_face), which holds for a receiver behind the face's tangent plane only (one
+  // in front reaches a point behind the face through it, whatever its depth).
   const float* last_thickness_plane() const {
     return last_thickness_.empty() ? nullptr : last_thickness_.data();
   }
+  // The depth that holds for every receiver (0: none).
   float last_thickness(int x, int y) const {
-    return last_thickness_.empty() ? 0.0f : last_thickness_[index(x, y)];
+    return last_thickness_.empty() ? 0.0f : std::max(last_thickness_[index(x, y)], 0.0f);
+  }
+  // The depth that holds for a receiver at p (0: none).
+  float last_thickness_seen_from(int x, int y, Vec3 p) const {
+    const float t = last_thickness_.empty() ? 0.0f : last_thickness_[index(x, y)];
+    if (!(t < 0.0f)) return t;
+    return dot(p - position(x, y), normal(x, y)) < 0.0f ? -t : 0.0f;
   }
   static constexpr int kThicknessSearch = 8;
 
@@ -224,6 +235,16 @@ class Frame {
   // Fills last_thickness_ from the finished depth and layer planes.
   void infer_last_thickness(TilePool& pool, Progress& progress);
   void measure_post_thickness(TilePool& pool, Progress& progress);
+  // Where a run of pixels on one surface ends at (x, y), the surface dropping away to (x + dx,
+  // y + dy): bounds the depth of its last face's solid (last_thickness_plane, negated).
+  void bound_by_side_face(int x, int y, int dx, int dy, int run);
+  // A side face this deep would reach this far past the face's edge on screen: half the way to
+  // the next pixel's centre, the edge's expected place between the two.
+  static constexpr float kSideFacePixels = 0.5f;
+  // Two normals within about 6 degrees: one face (a corner's pixels mix two faces' normals).
+  static constexpr float kSameFaceCos = 0.995f;
+  // Faces seen within about 45 degrees of face-on are bounded.
+  static constexpr float kSideFaceFacingCos = 0.7f;
   // Fills plane_distance_scale_ from the finished depth and normal planes.
   void measure_plane_distance_scale(TilePool& pool, Progress& progress);
   void plane_distance_scale_row(int x0, int count, int y, float* out) const;

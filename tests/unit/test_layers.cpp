@@ -57,6 +57,11 @@ Error error_against(const std::vector<float>& ao, const std::vector<double>& ref
 struct Scored {
   std::vector<size_t> pixels;
   std::vector<double> reference;
+  double mean_reference() const {
+    double mean = 0;
+    for (double r : reference) mean += r / double(reference.size());
+    return mean;
+  }
 };
 
 // The geometry pixels of `s` at least `margin_x` / `margin_y` px inside the frame, every
@@ -76,6 +81,22 @@ Scored score_where(const Scene& s, const std::vector<Solid>& solids, int rays, i
     }
   }
   return scored;
+}
+
+// One layer's AO of the scene `solids` make, seen by `cam`, against 512-ray AO over the pixels
+// `keep` selects (8 px inside the frame's sides, `margin_y` inside its top and bottom, every
+// `row_step`-th row); the ray-traced mean into `mean_reference`. No error (count 0) with fewer
+// than `min_pixels` of them.
+template <class Keep>
+Error one_layer_error_where(const Camera& cam, const std::vector<Solid>& solids, int margin_y,
+                            int row_step, size_t min_pixels, Keep keep,
+                            double* mean_reference = nullptr) {
+  Scene s = ray_cast(cam, solids);
+  const Scored scored = score_where(s, solids, 512, 8, margin_y, row_step, keep);
+  EXPECT_GE(scored.pixels.size(), min_pixels);
+  if (scored.pixels.size() < min_pixels) return Error{};
+  if (mean_reference != nullptr) *mean_reference = scored.mean_reference();
+  return error_against(layered_ao(s, cam, false), scored.reference, scored.pixels);
 }
 
 // A floor seen from 30 degrees above, a sphere of radius 1 resting on it in the middle of the
@@ -269,16 +290,60 @@ TEST(Layers, OneLayerTakesAPostsDepthFromItsWidth) {
   const std::vector<Solid> solids = {{{{0, 0, wall_z}, {0, 0, 1}}},
                                      box({-0.7, -10, back}, {-0.5, 10, front}),
                                      box({0.5, -10, back}, {0.7, 10, front})};
-  Scene s = ray_cast(cam, solids);
-  const Scored wall = score_where(s, solids, 512, 8, 8, 2, [&](const V3& p) {
+  const Error one = one_layer_error_where(cam, solids, 8, 2, 500, [&](const V3& p) {
     return std::fabs(p.z - wall_z) < 1e-6 && std::fabs(p.x) < 1.2;
   });
-  ASSERT_GT(wall.pixels.size(), 500u);
-  const Error one = error_against(layered_ao(s, cam, false), wall.reference, wall.pixels);
   std::printf("[ measure  ] two posts before a wall, %d wall px: one layer RMSE %.4f bias %+.4f\n",
               one.count, one.rmse, one.bias);
   EXPECT_LT(one.rmse, 0.05);
   EXPECT_GT(one.bias, -0.04);
+}
+
+// Without extra layers a face bounds its solid's depth by the side face a deeper solid would
+// show (Frame::bound_by_side_face): a rail 0.2 tall and 0.05 deep, above the eye and 0.3 in
+// front of a wall, shows its front and a pixel or so of its underside; were it deeper, more of
+// the underside would show below it where the wall does. The wall above and below it is
+// darkened only as much as by something that thin, where the assumed thickness (half the
+// radius) made it a block reaching the wall.
+TEST(Layers, OneLayerBoundsARailByTheSideItDoesNotShow) {
+  Camera cam;
+  cam.width = 128, cam.height = 96;
+  const double wall_z = -6.0, front = -5.7, back = -5.65, rail_y = 1.2;
+  const std::vector<Solid> solids = {{{{0, 0, wall_z}, {0, 0, 1}}},
+                                     box({-10, rail_y, front}, {10, rail_y + 0.2, back})};
+  const Error one = one_layer_error_where(cam, solids, 4, 1, 500, [&](const V3& p) {
+    return std::fabs(p.z - wall_z) < 1e-6 && std::fabs(p.y - rail_y - 0.1) < 0.7;
+  });
+  std::printf("[ measure  ] a rail before a wall, %d wall px: one layer RMSE %.4f bias %+.4f\n",
+              one.count, one.rmse, one.bias);
+  EXPECT_LT(one.rmse, 0.05);
+  EXPECT_GT(one.bias, -0.04);
+}
+
+// The bound holds for a receiver behind the face only: a board 0.02 thick standing on a floor,
+// its top well below the eye, shows no top face (so it is bounded), yet the floor in front
+// of it reaches the points behind the board through its face and stays as dark as a ray
+// tracer's.
+TEST(Layers, ABoundedBoardStillShadesTheFloorBeforeIt) {
+  Camera cam;
+  cam.width = 96, cam.height = 128;  // portrait: the floor before the board is in the frame
+  const double floor_y = -1.5, board_z = -4.0, board_top = -0.9;
+  const std::vector<Solid> solids = {{{{0, floor_y, 0}, {0, 1, 0}}},
+                                     box({-10, floor_y, board_z - 0.02}, {10, board_top, board_z})};
+  double mean_reference = 1.0;
+  const Error one = one_layer_error_where(
+      cam, solids, 4, 1, 300,
+      [&](const V3& p) {
+        return std::fabs(p.y - floor_y) < 1e-6 && p.z > board_z && p.z < board_z + 0.6;
+      },
+      &mean_reference);
+  std::printf(
+      "[ measure  ] floor before a board, %d px (ray-traced mean %.4f): one layer RMSE %.4f "
+      "bias %+.4f\n",
+      one.count, mean_reference, one.rmse, one.bias);
+  EXPECT_LT(mean_reference, 0.85);  // the board occludes: the test measures something
+  EXPECT_LT(one.rmse, 0.06);
+  EXPECT_LT(one.bias, 0.04);
 }
 
 TEST(Layers, ThinBoardOverAWallIsNoLighterWithLayers) {
@@ -311,8 +376,7 @@ TEST(Layers, ThinBoardOverAWallIsNoLighterWithLayers) {
   const Error three = error_against(layered_ao(s, cam, true), reference, pixels);
   const Error three_6 =
       error_against(layered_ao(s, cam, true, true, "full", "hemisphere", 6), reference, pixels);
-  double mean_reference = 0;
-  for (double r : reference) mean_reference += r / double(reference.size());
+  const double mean_reference = scored.mean_reference();
   std::printf(
       "[ measure  ] 2 cm board over a wall, %d wall px under it (ray-traced mean %.4f), %d px "
       "band: one layer RMSE %.4f bias %+.4f; 3 hits RMSE %.4f bias %+.4f (4 x 6 steps: %.4f "
@@ -351,8 +415,7 @@ TEST(Layers, ABoardSeenEdgeOnDarkensTheWallBesideIt) {
   ASSERT_GT(scored.pixels.size(), 300u);
   const Error one = error_against(layered_ao(s, cam, false), scored.reference, scored.pixels);
   const Error three = error_against(layered_ao(s, cam, true), scored.reference, scored.pixels);
-  double mean_reference = 0;
-  for (double r : scored.reference) mean_reference += r / double(scored.reference.size());
+  const double mean_reference = scored.mean_reference();
   std::printf(
       "[ measure  ] 2 cm board seen edge-on, %d wall px beside it (ray-traced mean %.4f): one "
       "layer RMSE %.4f bias %+.4f; 3 hits RMSE %.4f bias %+.4f\n",

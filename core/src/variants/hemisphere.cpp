@@ -263,16 +263,30 @@ HWY_INLINE VF between_lanes(const HemisphereRowArgs& a, const LaneProjection<VF>
   return hn::IfThenElseZero(inside, covered * hn::IfThenElse(hn::Lt(next, zero), one, thick));
 }
 
-// Without extra layers: 1 / the depth of the visible surface's solid at pixel `index`, the
-// assumed thickness or, where the frame measured a post there (Frame::last_thickness), that if
-// less.
+// Without extra layers: 1 / the depth of the visible surface's solid at pixel `index` (point q)
+// for the receiver p, the assumed thickness or, where the frame bounds it there, the bound if
+// less (Frame::last_thickness_seen_from: a side-face bound, stored negated, for a receiver
+// behind the face's tangent plane only).
 template <class VF, class VI>
-HWY_INLINE VF inv_visible_thickness_lanes(const HemisphereRowArgs& a, VI index) {
+HWY_INLINE VF inv_visible_thickness_lanes(const HemisphereRowArgs& a, VI index, VF px, VF py, VF pz,
+                                          VF qx, VF qy, VF qz) {
   namespace hn = hwy::HWY_NAMESPACE;
   const hn::DFromV<VF> df;
+  const hn::RebindToSigned<decltype(df)> di;
   if (a.last_thickness == nullptr) return hn::Set(df, 1.0f / a.thickness);
-  const VF measured = hn::GatherIndex(df, a.last_thickness, index);
-  const auto known = hn::Gt(measured, hn::Zero(df));
+  const VF signed_measure = hn::GatherIndex(df, a.last_thickness, index);
+  const VF measured = hn::Abs(signed_measure);
+  auto known = hn::Gt(signed_measure, hn::Zero(df));
+  // A bound no less than the assumed thickness changes nothing: no normal to read for it.
+  const auto sided = hn::And(hn::Lt(signed_measure, hn::Zero(df)),
+                             hn::Gt(signed_measure, hn::Set(df, -a.thickness)));
+  if (!hn::AllFalse(df, sided)) {
+    VF nx, ny, nz;
+    decode_directions(df, hn::GatherIndex(di, reinterpret_cast<const int32_t*>(a.normals), index),
+                      nx, ny, nz);
+    const VF side = hn::MulAdd(px - qx, nx, hn::MulAdd(py - qy, ny, (pz - qz) * nz));
+    known = hn::Or(known, hn::And(sided, hn::Lt(side, hn::Zero(df))));
+  }
   return hn::Max(hn::Set(df, 1.0f / a.thickness),
                  hn::IfThenElseZero(known, hn::Set(df, 1.0f) /
                                                hn::IfThenElse(known, measured, hn::Set(df, 1.0f))));
@@ -333,7 +347,7 @@ HWY_INLINE VF solid_weight_lanes(const HemisphereRowArgs& a, VI index, M hidden,
 template <class M, class VF>
 HWY_INLINE VF beyond_frame_lanes(const HemisphereRowArgs& a, const LaneProjection<VF>& project,
                                  M outside, VF su, VF sv, VF sx, VF sy, VF sz, VF gx, VF gy, VF gz,
-                                 VF plane_level) {
+                                 VF plane_level, VF px, VF py, VF pz) {
   namespace hn = hwy::HWY_NAMESPACE;
   const hn::DFromV<VF> df;
   const hn::RebindToSigned<decltype(df)> di;
@@ -378,7 +392,9 @@ HWY_INLINE VF beyond_frame_lanes(const HemisphereRowArgs& a, const LaneProjectio
   if (hn::AllFalse(df, counts)) return zero;
   if (a.extra_layers == 0) {  // the visible surface, within its solid's depth
     return hn::IfThenElseZero(
-        counts, thickness_weight_lanes(ahead, inv_visible_thickness_lanes<VF>(a, index)));
+        counts, thickness_weight_lanes(
+                    ahead, inv_visible_thickness_lanes<VF>(a, index, px, py, pz, ray_x * q_scale,
+                                                           ray_y * q_scale, hn::Neg(qd))));
   }
   // The border pixel's hits go on beyond the frame too: the sample, `ahead` behind the plane,
   // stands where a point that far behind the border pixel's visible surface stands among them.
@@ -500,7 +516,7 @@ HWY_NOINLINE void hemisphere_row_of(const HemisphereRowArgs& a, int y, int x0, i
         const auto outside = hn::AndNot(in_image, in_front);
         if (!hn::AllFalse(df, outside)) {
           blocked = hn::Max(blocked, beyond_frame_lanes(a, project, outside, su, sv, sx, sy, sz, gx,
-                                                        gy, gz, plane_level));
+                                                        gy, gz, plane_level, px, py, pz));
         }
         seen = hn::Or(seen, in_front);
         if constexpr (!kLayers) {
@@ -523,8 +539,8 @@ HWY_NOINLINE void hemisphere_row_of(const HemisphereRowArgs& a, int y, int x0, i
               hn::And(hn::And(in_image, hn::Lt(qd, inf)), hn::Gt(level, plane_level));
           const VF covered =
               hn::Min(one, hn::Max(zero, cone_part_lanes(behind, hn::LoadU(df, cone))));
-          const VF thick =
-              thickness_weight_lanes(behind, inv_visible_thickness_lanes<VF>(a, index));
+          const VF thick = thickness_weight_lanes(
+              behind, inv_visible_thickness_lanes<VF>(a, index, px, py, pz, qxv, qyv, qzv));
           blocked = hn::Max(blocked, hn::IfThenElseZero(above, covered * thick));
           // Hidden beyond that solid's reach: the surface beyond the nearest silhouette, carried
           // on behind the object (Frame::carried_depth), occludes within the assumed thickness
@@ -891,7 +907,7 @@ class Hemisphere final : public Variant {
             // The surface the sample lies behind (the visible one without extra layers), if any,
             // when above the tangent plane.
             float entry = Frame::kBackground;
-            const float weight = solid_weight(f, qx, qy, -sample.z, entry);
+            const float weight = solid_weight(f, qx, qy, -sample.z, p, entry);
             if (entry != Frame::kBackground) {
               const Vec3 q = f.camera().view_position(float(qx) + 0.5f, float(qy) + 0.5f, entry);
               if (dot(q - p, geometric_normal) > min_height) {
@@ -967,7 +983,7 @@ class Hemisphere final : public Variant {
     // The border pixel's hits go on beyond the frame too: the sample, `ahead` behind the plane,
     // stands where a point that far behind the border pixel's visible surface stands among them.
     float entry = Frame::kBackground;
-    return solid_weight(f, qx, qy, f.depth(qx, qy) + ahead, entry);
+    return solid_weight(f, qx, qy, f.depth(qx, qy) + ahead, p, entry);
   }
 
   // A sample hidden behind the visible surface of pixel (qx, qy), without extra layers: the
@@ -990,14 +1006,16 @@ class Hemisphere final : public Variant {
   // Frame::solid_entry for a point at planar depth `depth` on the ray of pixel (qx, qy), into
   // `entry`, and how much the solid it lies in occludes it: 1 inside a solid that a back face
   // closes, else by the solid's thickness (measured beside the foreground for the ray's last
-  // hit, Frame::last_thickness, else assumed); 0 where entry is kBackground (the point is in
-  // front of the visible surface or in free space). The vector path's solid_weight_lanes.
-  float solid_weight(const Frame& f, int qx, int qy, float depth, float& entry) const {
+  // hit, or bounded for the receiver p, Frame::last_thickness_seen_from, else assumed); 0 where
+  // entry is kBackground (the point is in front of the visible surface or in free space). The
+  // vector path's solid_weight_lanes.
+  float solid_weight(const Frame& f, int qx, int qy, float depth, Vec3 p, float& entry) const {
     bool closed = false, past_last = false;
     entry = f.solid_entry(qx, qy, depth, closed, &past_last);
     if (entry == Frame::kBackground) return 0.0f;
-    const float measured = past_last ? f.last_thickness(qx, qy) : 0.0f;
-    // Without extra layers the measure is a post's depth, taken where it is the less.
+    const float measured = past_last ? f.last_thickness_seen_from(qx, qy, p) : 0.0f;
+    // Without extra layers the measure is a bound (a post's width, the side face a deeper solid
+    // would show), taken where it is the less.
     const float depth_of_solid =
         !(measured > 0.0f) ? thickness_
                            : (f.extra_layers() > 0 ? measured : std::min(measured, thickness_));
