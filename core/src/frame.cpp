@@ -104,6 +104,34 @@ struct CarriedPlane {
 bool on_one_surface(float a, float b) {
   return a < b * Frame::kCarryJump && b < a * Frame::kCarryJump;
 }
+
+// Whether past a run's end pixel (depth `inside`) lies background or a surface farther by
+// Frame::kCarryJump.
+bool drops_away(float inside, float past) {
+  return past == Frame::kBackground || past > inside * Frame::kCarryJump;
+}
+
+// Along a line of `count` pixels whose planar depths depth_at(i) gives: on_run(begin, end,
+// drops_before, drops_after) for each run [begin, end) of geometry pixels on one surface;
+// drops_*: the surface drops away just past that end (never at the line's ends).
+template <class DepthAt, class OnRun>
+void for_each_run(int count, DepthAt depth_at, OnRun on_run) {
+  int begin = 0;
+  while (begin < count) {
+    if (depth_at(begin) == Frame::kBackground) {
+      ++begin;
+      continue;
+    }
+    int end = begin + 1;
+    while (end < count && depth_at(end) != Frame::kBackground &&
+           on_one_surface(depth_at(end - 1), depth_at(end))) {
+      ++end;
+    }
+    on_run(begin, end, begin > 0 && drops_away(depth_at(begin), depth_at(begin - 1)),
+           end < count && drops_away(depth_at(end - 1), depth_at(end)));
+    begin = end;
+  }
+}
 }  // namespace
 
 // Per tile, each of the four walks is a scan towards the pixels from kCarrySearch pixels beyond
@@ -226,60 +254,32 @@ void Frame::find_carried_surfaces(TilePool& pool, Progress& progress) {
 void Frame::measure_post_thickness(TilePool& pool, Progress& progress) {
   constexpr int kPostBandRows = 64, kMinPostPixels = 4;
   constexpr float kDepthPerWidth = 2.0f / 3.0f;
-  const auto drops_away = [](float inside, float past) {
-    return past == kBackground || past > inside * kCarryJump;
-  };
   pool.for_each_row_band(width_, height_, kPostBandRows, progress, [&](const Tile& t) {
     for (int y = t.y0; y < t.y1; ++y) {
       const float* row = depth_.data() + index(0, y);
       float* out = last_thickness_.data() + index(0, y);
       std::fill_n(out, width_, 0.0f);
-      int x = 0;
-      while (x < width_) {
-        if (row[x] == kBackground) {
-          ++x;
-          continue;
-        }
-        int end = x + 1;
-        float nearest = row[x], farthest = row[x];
-        while (end < width_ && row[end] != kBackground && on_one_surface(row[end - 1], row[end])) {
-          nearest = std::min(nearest, row[end]), farthest = std::max(farthest, row[end]);
-          ++end;
-        }
-        const bool left = x > 0 && drops_away(row[x], row[x - 1]);
-        const bool right = end < width_ && drops_away(row[end - 1], row[end]);
+      const auto depth_at = [&](int x) { return row[x]; };
+      for_each_run(width_, depth_at, [&](int x, int end, bool left, bool right) {
         if (end - x >= kMinPostPixels && left && right) {
-          const float width = float(end - x) * camera_.pixel_footprint(0.5f * (nearest + farthest));
-          std::fill(out + x, out + end, kDepthPerWidth * std::max(width, farthest - nearest));
+          const auto [nearest, farthest] = std::minmax_element(row + x, row + end);
+          const float width =
+              float(end - x) * camera_.pixel_footprint(0.5f * (*nearest + *farthest));
+          std::fill(out + x, out + end, kDepthPerWidth * std::max(width, *farthest - *nearest));
         }
         if (left) bound_by_side_face(x, y, -1, 0, end - x);
         if (right) bound_by_side_face(end - 1, y, 1, 0, end - x);
-        x = end;
-      }
+      });
     }
   });
   // Down the columns, bands of columns (the tile's rows are columns here).
   pool.for_each_row_band(height_, width_, kPostBandRows, progress, [&](const Tile& t) {
     for (int x = t.y0; x < t.y1; ++x) {
-      int y = 0;
-      while (y < height_) {
-        if (depth(x, y) == kBackground) {
-          ++y;
-          continue;
-        }
-        int end = y + 1;
-        while (end < height_ && depth(x, end) != kBackground &&
-               on_one_surface(depth(x, end - 1), depth(x, end))) {
-          ++end;
-        }
-        if (y > 0 && drops_away(depth(x, y), depth(x, y - 1))) {
-          bound_by_side_face(x, y, 0, -1, end - y);
-        }
-        if (end < height_ && drops_away(depth(x, end - 1), depth(x, end))) {
-          bound_by_side_face(x, end - 1, 0, 1, end - y);
-        }
-        y = end;
-      }
+      const auto depth_at = [&](int y) { return depth(x, y); };
+      for_each_run(height_, depth_at, [&](int y, int end, bool top, bool bottom) {
+        if (top) bound_by_side_face(x, y, 0, -1, end - y);
+        if (bottom) bound_by_side_face(x, end - 1, 0, 1, end - y);
+      });
     }
   });
 }
@@ -295,14 +295,18 @@ void Frame::measure_post_thickness(TilePool& pool, Progress& progress) {
 // the row-only post measure could not read columns (a shelf edge-on was taken for a rail).
 void Frame::bound_by_side_face(int x, int y, int dx, int dy, int run) {
   // The face's orientation: the normal of the first pixel from the end whose normal its inner
-  // neighbour shares (a renderer's Normal pass mixes the faces at a corner's pixels).
-  Vec3 n{};
+  // neighbour shares (a renderer's Normal pass mixes the faces at a corner's pixels). normal_in:
+  // k pixels in from the end; shares_next: the pixel after it (k + 1 < run) has its normal.
+  const auto normal_in = [&](int k) { return normal(x - k * dx, y - k * dy); };
+  const auto shares_next = [&](int k) {
+    return dot(normal_in(k), normal_in(k + 1)) > kSameFaceCos;
+  };
   int first = -1;
   for (int k = 0; k < 2 && k + 1 < run && first < 0; ++k) {
-    const Vec3 a = normal(x - k * dx, y - k * dy), b = normal(x - (k + 1) * dx, y - (k + 1) * dy);
-    if (dot(a, b) > kSameFaceCos) n = a, first = k;
+    if (shares_next(k)) first = k;
   }
   if (first < 0) return;
+  const Vec3 n = normal_in(first);
   const Vec3 p = position(x, y), towards = camera_.towards_camera(p);
   const Vec3 facing = dot(n, towards) < 0.0f ? n * -1.0f : n;
   // A face seen at more than about 45 degrees says nothing: what samples reach behind it is a
@@ -324,14 +328,10 @@ void Frame::bound_by_side_face(int x, int y, int dx, int dy, int run) {
   // Over the face only: the end's pixels before it, then inward until another face begins (a
   // pixel whose normal differs and that its inner neighbour shares; mixed pixels pass).
   for (int k = 0; k < run; ++k) {
-    const int px = x - k * dx, py = y - k * dy;
-    if (k > first && k + 1 < run) {
-      const Vec3 here = normal(px, py);
-      if (!(dot(here, n) > kSameFaceCos) && dot(here, normal(px - dx, py - dy)) > kSameFaceCos) {
-        break;
-      }
+    if (k > first && k + 1 < run && !(dot(normal_in(k), n) > kSameFaceCos) && shares_next(k)) {
+      break;
     }
-    float& cell = last_thickness_[index(px, py)];
+    float& cell = last_thickness_[index(x - k * dx, y - k * dy)];
     if (cell == 0.0f || bound < std::fabs(cell)) cell = -bound;
   }
 }
