@@ -85,16 +85,16 @@ Scored score_where(const Scene& s, const std::vector<Solid>& solids, int rays, i
 
 // One layer's AO of the scene `solids` make, seen by `cam`, against 512-ray AO over the pixels
 // `keep` selects (8 px inside the frame's sides, `margin_y` inside its top and bottom, every
-// `row_step`-th row); the ray-traced mean into `mean_reference`. No error (count 0) with fewer
-// than `min_pixels` of them.
+// `row_step`-th row); the ray-traced mean into `mean_reference`. A failure, and no error
+// (count 0), unless there are more than `more_than` of them.
 template <class Keep>
 Error one_layer_error_where(const Camera& cam, const std::vector<Solid>& solids, int margin_y,
-                            int row_step, size_t min_pixels, Keep keep,
+                            int row_step, size_t more_than, Keep keep,
                             double* mean_reference = nullptr) {
   Scene s = ray_cast(cam, solids);
   const Scored scored = score_where(s, solids, 512, 8, margin_y, row_step, keep);
-  EXPECT_GE(scored.pixels.size(), min_pixels);
-  if (scored.pixels.size() < min_pixels) return Error{};
+  EXPECT_GT(scored.pixels.size(), more_than);
+  if (!(scored.pixels.size() > more_than)) return Error{};
   if (mean_reference != nullptr) *mean_reference = scored.mean_reference();
   return error_against(layered_ao(s, cam, false), scored.reference, scored.pixels);
 }
