@@ -320,6 +320,28 @@ TEST(Layers, OneLayerBoundsARailByTheSideItDoesNotShow) {
   EXPECT_GT(one.bias, -0.04);
 }
 
+// Slats 0.4 wide and 0.1 deep, 0.5 in front of a wall 13 away: 4 % nearer than the wall, less
+// than the depth jump that ends a run of one surface (Frame::kCarryJump, 5 %), yet far more than
+// the slats' and the wall's own steps from pixel to pixel, so each slat's run ends at its edges
+// and its width bounds its depth (Frame::measure_post_thickness). The wall between them is then
+// darkened about as by something that thin, where the assumed thickness (half the radius) made
+// each slat a block reaching the wall: RMSE 0.151, bias -0.144 against ray-traced AO.
+TEST(Layers, OneLayerTellsSlatsFromTheWallJustBehindThem) {
+  Camera cam;
+  cam.width = 128, cam.height = 96;
+  const double wall_z = -13.0, back = -12.5, front = -12.4;
+  std::vector<Solid> solids = {{{{0, 0, wall_z}, {0, 0, 1}}}};
+  for (int k = -5; k <= 5; ++k) {
+    solids.push_back(box({k * 1.2 - 0.2, -10, back}, {k * 1.2 + 0.2, 10, front}));
+  }
+  const Error one = one_layer_error_where(
+      cam, solids, 4, 1, 500, [&](const V3& p) { return std::fabs(p.z - wall_z) < 1e-6; });
+  std::printf("[ measure  ] slats 4 %% before a wall, %d wall px: one layer RMSE %.4f bias %+.4f\n",
+              one.count, one.rmse, one.bias);
+  EXPECT_LT(one.rmse, 0.11);
+  EXPECT_GT(one.bias, -0.08);
+}
+
 // The bound holds for a receiver behind the face only: a board 0.02 thick standing on a floor,
 // its top well below the eye, shows no top face (so it is bounded), yet the floor in front
 // of it reaches the points behind the board through its face and stays as dark as a ray
