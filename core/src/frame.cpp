@@ -254,23 +254,25 @@ void Frame::find_carried_surfaces(TilePool& pool, Progress& progress) {
   });
 }
 
-// Along each row, a run of pixels on one surface (for_each_run) with a
-// farther surface or background just past both ends is something narrow standing in front: a
-// post, a leg, a column. Its depth is taken from its width, as a round or square post's: the
-// thickness fade counts a point fully up to the thickness and not at all past twice it, so the
-// thickness is 2/3 of the larger of the run's width (view units, at its mean depth) and its
-// depth span (a surface seen at a grazing angle is as deep as it recedes). Rows only: a narrow
-// run down a column is more often a horizontal slab seen edge-on (a shelf at the eye's height),
-// as deep as the furniture it belongs to (`cavity`'s bookcase: RMSE 0.0522 -> 0.0632 with
-// columns read too). Runs of 4 pixels or more: in fewer the pixel grid sets the width more than
-// the post does (a post 2.5 px wide covers 2 or 3 pixel centres as the camera moves), and the
-// depth it gives flickers (`thin`'s 320x180 camera move, occluded flicker 0.0251 without the
-// measure, 0.0313 reading every run, 0.0260 from 4 px). A run at the frame's edge, or with a
-// nearer surface past an end, says nothing (0).
+// Along each row, a run of pixels on one surface (for_each_run) with a farther surface or
+// background just past both ends is something narrow standing in front: a post, a leg, a
+// column. Its depth is taken from its width, as a round or square post's: the thickness fade
+// counts a point fully up to the thickness and not at all past twice it, so the thickness is
+// 2/3 of the larger of the run's width (view units, at its mean depth) and its depth span (a
+// surface seen at a grazing angle is as deep as it recedes). Rows only: a narrow run down a
+// column is more often a horizontal slab seen edge-on (a shelf at the eye's height), as deep as
+// the furniture it belongs to (`cavity`'s bookcase: RMSE 0.0522 -> 0.0632 with columns read
+// too). A run of fewer than kPostWidthPixels is taken as that wide: the pixel grid sets its
+// width more than the post does (a post 2.5 px wide covers 2 or 3 pixel centres as the camera
+// moves), and it is narrower than that. Measuring such runs as they are flickered (`thin`'s
+// 320x180 camera move, occluded flicker 0.0251 without the measure, 0.0313 reading every run),
+// and leaving them out switched a 3 px slat between that depth and the assumed thickness from
+// frame to frame (0.0349; 0.0265 taking them as 4 px wide). A run at the frame's edge, or with
+// a nearer surface past an end, says nothing (0).
 // Where a run along a row or a column ends in a drop, the face there bounds its solid's depth
 // besides (bound_by_side_face): a rail or a board whose side a deeper solid would show.
 void Frame::measure_post_thickness(TilePool& pool, Progress& progress) {
-  constexpr int kPostBandRows = 64, kMinPostPixels = 4;
+  constexpr int kPostBandRows = 64, kPostWidthPixels = 4;
   constexpr float kDepthPerWidth = 2.0f / 3.0f;
   pool.for_each_row_band(width_, height_, kPostBandRows, progress, [&](const Tile& t) {
     for (int y = t.y0; y < t.y1; ++y) {
@@ -279,10 +281,10 @@ void Frame::measure_post_thickness(TilePool& pool, Progress& progress) {
       std::fill_n(out, width_, 0.0f);
       const auto depth_at = [&](int x) { return row[x]; };
       for_each_run(width_, depth_at, [&](int x, int end, bool left, bool right) {
-        if (end - x >= kMinPostPixels && left && right) {
+        if (left && right) {
           const auto [nearest, farthest] = std::minmax_element(row + x, row + end);
-          const float width =
-              float(end - x) * camera_.pixel_footprint(0.5f * (*nearest + *farthest));
+          const float width = float(std::max(end - x, kPostWidthPixels)) *
+                              camera_.pixel_footprint(0.5f * (*nearest + *farthest));
           std::fill(out + x, out + end, kDepthPerWidth * std::max(width, *farthest - *nearest));
         }
         if (left) bound_by_side_face(x, y, -1, 0, end - x);
