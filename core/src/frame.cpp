@@ -155,7 +155,8 @@ void for_each_run(int count, DepthAt depth_at, OnRun on_run) {
 // Per tile, each of the four walks is a scan towards the pixels from kCarrySearch pixels beyond
 // the tile's edge, keeping the nearest stop seen so far (a step onto a farther surface, or
 // background) with its surface's plane: O(pixels) however far the search reaches, one plane per
-// stop, and per pixel where its ray meets the plane.
+// stop, and per pixel where its ray meets the plane; of the four walks' planes, the one the ray
+// meets first.
 void Frame::find_carried_surfaces(TilePool& pool, Progress& progress) {
   if (extra_layers_ > 0 || normal_.empty()) {
     std::vector<float>().swap(carried_depth_);
@@ -186,25 +187,22 @@ void Frame::find_carried_surfaces(TilePool& pool, Progress& progress) {
   pool.for_each_row_band(width_, height_, kCarryBandRows, progress, [&](const Tile& t) {
     const int w = width_, h = t.y1 - t.y0;
     ScratchVector<float> best(size_t(w) * size_t(h));
-    ScratchVector<uint8_t> nearest(size_t(w) * size_t(h));
     std::fill(best.begin(), best.end(), kBackground);
-    std::fill(nearest.begin(), nearest.end(), uint8_t(kCarrySearch + 1));
     uint32_t* normals_out = carried_normal_.data() + index(0, t.y0);
-    // Pixel (x, y) of depth d, `distance` pixels from the stop whose plane is `plane`: where its
-    // ray meets the plane, if farther than its surface by kCarryJump and the nearest so far.
-    const auto consider = [&](int x, int y, float d, const CarriedPlane& plane, int distance) {
+    // Pixel (x, y) of depth d, within kCarrySearch pixels of the stop whose plane is `plane`:
+    // where its ray meets the plane, if farther than its surface by kCarryJump and nearer than
+    // the planes of the other stops (behind a sphere on a floor before a wall, the floor's plane
+    // from beside it, before the wall's from above it: the crease they make behind it).
+    const auto consider = [&](int x, int y, float d, const CarriedPlane& plane) {
       const size_t slot = size_t(y - t.y0) * size_t(w) + size_t(x);
-      if (!plane.usable || distance > nearest[slot] || d == kBackground) return;
+      if (!plane.usable || d == kBackground) return;
       float meets;
       if (!camera_.depth_on_plane(float(x) + 0.5f, float(y) + 0.5f, plane.n, plane.w, meets) ||
-          !(meets > d * kCarryJump) || !(meets < kBackground)) {
+          !(meets > d * kCarryJump) || !(meets < best[slot])) {
         return;
       }
-      if (distance < nearest[slot] || meets < best[slot]) {
-        nearest[slot] = uint8_t(distance);
-        best[slot] = meets;
-        normals_out[slot] = plane.packed;
-      }
+      best[slot] = meets;
+      normals_out[slot] = plane.packed;
     };
     // Along rows, right then left, scanning against the walk: the nearest stop ahead (a pixel of
     // background, or a step from the pixel before onto a surface farther by kCarryJump).
@@ -215,7 +213,7 @@ void Frame::find_carried_surfaces(TilePool& pool, Progress& progress) {
         CarriedPlane plane;
         for (int x = dx > 0 ? w - 1 : 0; x >= 0 && x < w; x -= dx) {
           if (stop >= 0 && std::abs(stop - x) <= kCarrySearch) {
-            consider(x, y, row[x], plane, std::abs(stop - x));
+            consider(x, y, row[x], plane);
           }
           const int before = x - dx;
           if (row[x] == kBackground ||
@@ -241,7 +239,7 @@ void Frame::find_carried_surfaces(TilePool& pool, Progress& progress) {
         const bool inside = y >= t.y0 && y < t.y1;
         for (int x = 0; x < w; ++x) {
           if (inside && stop[size_t(x)] >= 0 && std::abs(stop[size_t(x)] - y) <= kCarrySearch) {
-            consider(x, y, row[x], plane[size_t(x)], std::abs(stop[size_t(x)] - y));
+            consider(x, y, row[x], plane[size_t(x)]);
           }
           if (row[x] == kBackground ||
               (row_before != nullptr && row[x] > row_before[x] * kCarryJump)) {

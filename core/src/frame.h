@@ -189,13 +189,13 @@ class Frame {
     return extra_layers_ > 0 ? plane_distance_scale_[index(x, y)] : 0.0f;
   }
 
-  // Without extra layers, per pixel: the planar depth at which the pixel's ray meets the surface
-  // beyond the nearest silhouette around it, carried on behind the object as its tangent plane
-  // (the floor going on under a sphere): walking from the pixel along its row or column, the
-  // first step onto a surface more than kCarryJump farther, within kCarrySearch pixels, on the
-  // nearest such side whose plane the ray meets more than kCarryJump behind the pixel's own
-  // surface; kBackground where none. Null with extra layers (they show the hidden surfaces) or
-  // without normals.
+  // Without extra layers, per pixel: the planar depth at which the pixel's ray meets the surfaces
+  // beyond the silhouettes around it, carried on behind the object as their tangent planes (the
+  // floor going on under a sphere): walking from the pixel along its row and its column, the
+  // first step onto a surface more than kCarryJump farther, within kCarrySearch pixels, on each
+  // of the four sides; of their planes that the ray meets more than kCarryJump behind the pixel's
+  // own surface, the nearest; kBackground where none. Null with extra layers (they show the hidden
+  // surfaces) or without normals.
   const float* carried_depth_plane() const {
     return carried_depth_.empty() ? nullptr : carried_depth_.data();
   }

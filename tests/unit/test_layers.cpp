@@ -213,6 +213,55 @@ TEST(Layers, TheSpheresUndersideShadesWithoutBands) {
   EXPECT_LT(three_bands, 0.0045);
 }
 
+// World coordinates (y up) seen by a camera at (0, eye_height, 0) looking along -z, pitched down
+// by `degrees`: solids into view space and view-space points back.
+struct PitchedView {
+  double c, sn;
+  V3 eye;
+  PitchedView(double degrees, double eye_height)
+      : c(std::cos(degrees * M_PI / 180.0)),
+        sn(std::sin(degrees * M_PI / 180.0)),
+        eye{0, eye_height, 0} {}
+  V3 rotate(V3 v) const { return V3{v.x, v.y * c - v.z * sn, v.y * sn + v.z * c}; }
+  Solid to_view(const Solid& solid) const {
+    Solid out;
+    for (const Plane& plane : solid)
+      out.push_back({rotate(plane.point - eye), rotate(plane.normal)});
+    return out;
+  }
+  V3 to_world(V3 p) const { return V3{p.x, p.y * c + p.z * sn, -p.y * sn + p.z * c} + eye; }
+};
+
+// A ball on a floor 7 before a wall, seen from low down: on screen it hides the crease where
+// the floor meets the wall. The wall just above the crease beside the ball's top is darkened by
+// the floor running on behind the ball. Of the surfaces seen beside the ball's silhouettes,
+// carried on behind it (Frame::carried_depth), the floor, seen beside its lower half, is the one
+// the rays through it meet first; the nearest silhouette's, the wall above the ball, carried the
+// wall down behind it and left the floor out: RMSE 0.1408, bias +0.1110 against ray-traced AO.
+TEST(Layers, OneLayerCarriesTheCreaseBehindABall) {
+  Camera cam;
+  cam.width = 160, cam.height = 120;
+  const PitchedView view(7.0, 1.5);
+  const double radius = 0.5, wall = -12.0, ball_z = wall + 7.0 + radius;
+  const std::vector<Solid> solids = {view.to_view({{{0, 0, 0}, {0, 1, 0}}}),
+                                     view.to_view(box({-40, -1, -60}, {40, 20, wall})),
+                                     view.to_view(polyhedral_sphere({0, radius, ball_z}, radius))};
+  Scene s = ray_cast(cam, solids);
+  // The wall within the radius above the crease, as wide as the ball on either side of it.
+  const Scored crease = score_where(s, solids, 256, 8, 8, 1, [&](const V3& p) {
+    const V3 world = view.to_world(p);
+    return std::fabs(world.z - wall) < 1e-6 && std::fabs(world.x) < 2.0 * radius && world.y < 1.0;
+  });
+  ASSERT_GT(crease.pixels.size(), 200u);
+  const Error error = error_against(layered_ao(s, cam, false), crease.reference, crease.pixels);
+  std::printf(
+      "[ measure  ] wall above the crease behind a ball, %zu px: one layer RMSE %.4f bias "
+      "%+.4f\n",
+      crease.pixels.size(), error.rmse, error.bias);
+  EXPECT_LT(error.rmse, 0.08);
+  EXPECT_LT(error.bias, 0.07);
+}
+
 TEST(Layers, OneLayerCarriesASurfaceOnBehindAPost) {
   // A post in front of a deep block standing on a floor, seen from above. The block's base
   // behind the post is hidden: without extra layers a sample from the floor in front of the
@@ -221,23 +270,14 @@ TEST(Layers, OneLayerCarriesASurfaceOnBehindAPost) {
   // plane (Frame::carried_depth), closes it.
   Camera cam;
   cam.width = 160, cam.height = 120;
-  // World: y up, the camera at (0, 3, 0) looking along -z, pitched down by 25 degrees.
-  const double pitch = 25.0 * M_PI / 180.0, c = std::cos(pitch), sn = std::sin(pitch);
-  const V3 eye{0, 3, 0};
-  const auto rotate = [&](V3 v) { return V3{v.x, v.y * c - v.z * sn, v.y * sn + v.z * c}; };
-  const auto to_view = [&](const Solid& solid) {
-    Solid out;
-    for (const Plane& plane : solid)
-      out.push_back({rotate(plane.point - eye), rotate(plane.normal)});
-    return out;
-  };
-  const std::vector<Solid> solids = {to_view({{{0, 0, 0}, {0, 1, 0}}}),
-                                     to_view(box({-20, -1, -30}, {20, 4, -9})),
-                                     to_view(box({-0.3, -1, -6.6}, {0.3, 4, -6.0}))};
+  const PitchedView view(25.0, 3.0);
+  const std::vector<Solid> solids = {view.to_view({{{0, 0, 0}, {0, 1, 0}}}),
+                                     view.to_view(box({-20, -1, -30}, {20, 4, -9})),
+                                     view.to_view(box({-0.3, -1, -6.6}, {0.3, 4, -6.0}))};
   Scene s = ray_cast(cam, solids);
   // The floor in front of the block's base, within the radius of it, beside and behind the post.
   const Scored base = score_where(s, solids, 256, 8, 8, 1, [&](const V3& p) {
-    const V3 world = V3{p.x, p.y * c + p.z * sn, -p.y * sn + p.z * c} + eye;
+    const V3 world = view.to_world(p);
     return std::fabs(world.y) < 1e-6 && world.z > -9.0 && world.z < -8.0 &&
            std::fabs(world.x) < 1.5;
   });
