@@ -519,23 +519,37 @@ void normal_rotation(const FrameInputs& in, float rotation[9]) {
 }
 }  // namespace
 
-void Frame::build(const FrameInputs& in, TilePool& pool, Progress& progress) {
+void Frame::build(const FrameInputs& in, TilePool& pool, Progress& progress, unsigned extras) {
   fill_depth(in, pool, progress);
   build_normals(in, pool, progress);
   unmix_normals(pool, progress);
-  infer_last_thickness(pool, progress);
-  measure_plane_distance_scale(pool, progress);
-  find_carried_surfaces(pool, progress);
+  derive_extras(extras, pool, progress);
+}
+
+void Frame::derive_extras(unsigned extras, TilePool& pool, Progress& progress) {
+  if ((extras & kSolidThickness) != 0) {
+    infer_last_thickness(pool, progress);
+  } else {
+    std::vector<float>().swap(last_thickness_);
+  }
+  if ((extras & kPlaneDistanceScale) != 0) {
+    measure_plane_distance_scale(pool, progress);
+  } else {
+    std::vector<float>().swap(plane_distance_scale_);
+  }
+  if ((extras & kCarriedSurfaces) != 0) {
+    find_carried_surfaces(pool, progress);
+  } else {
+    std::vector<float>().swap(carried_depth_);
+    std::vector<uint32_t>().swap(carried_normal_);
+  }
 }
 
 void Frame::build_depth(const FrameInputs& in, TilePool& pool, Progress& progress) {
   fill_depth(in, pool, progress);
   std::vector<uint32_t>().swap(normal_);  // what a run at full resolution kept
   std::vector<uint8_t>().swap(mixed_normal_);
-  std::vector<float>().swap(last_thickness_);
-  std::vector<float>().swap(plane_distance_scale_);
-  std::vector<float>().swap(carried_depth_);
-  std::vector<uint32_t>().swap(carried_normal_);
+  derive_extras(0u, pool, progress);  // frees them all
 }
 
 void Frame::fill_depth(const FrameInputs& in, TilePool& pool, Progress& progress) {
@@ -841,8 +855,8 @@ SSAO_VECTORIZE void Frame::nearest_of_blocks(const float* __restrict top,
   }
 }
 
-void Frame::downsample(const Frame& full, const FrameInputs& in, TilePool& pool,
-                       Progress& progress) {
+void Frame::downsample(const Frame& full, const FrameInputs& in, TilePool& pool, Progress& progress,
+                       unsigned extras) {
   reset(full.camera().coarser(2), (full.width() + 1) / 2, (full.height() + 1) / 2,
         full.extra_layers());
   normals_from_image_ = in.normal.attached();
@@ -894,9 +908,7 @@ void Frame::downsample(const Frame& full, const FrameInputs& in, TilePool& pool,
     }
   });
   unmix_normals(pool, progress);
-  infer_last_thickness(pool, progress);
-  measure_plane_distance_scale(pool, progress);
-  find_carried_surfaces(pool, progress);
+  derive_extras(extras, pool, progress);
 }
 
 float background_limit(double background_depth, double clip_end) {

@@ -41,6 +41,15 @@ struct FrameInputs {
 // background_limit from the parameters background_depth and clip_end (0: no clip).
 float background_limit(double background_depth, double clip_end);
 
+// What Frame::build derives from the depth and normals for the variants' sample tests; a variant
+// declares the ones it reads (VariantInfo::frame_extras) and the others' scans are skipped.
+enum FrameExtras : unsigned {
+  kSolidThickness = 1u,      // last_thickness_plane
+  kPlaneDistanceScale = 2u,  // plane_distance_scale_plane (with extra layers)
+  kCarriedSurfaces = 4u,     // carried_depth_plane, carried_normal_plane (with one layer)
+  kAllFrameExtras = 7u,
+};
+
 // Unit vector <-> 32 bits: octahedral mapping with 16 bits per coordinate (error < 1e-4 rad).
 // Both directions are branch-free (the lower half folded over the diagonals by a signed
 // offset), so loops over pixels vectorise.
@@ -89,16 +98,20 @@ class Frame {
   // that runs frame after frame allocates once).
   void reset(const CameraModel& camera, int width, int height, int extra_layers = 0);
 
-  // Fills the depth plane, then the normals (from the normal image or reconstructed from depth).
-  void build(const FrameInputs& in, TilePool& pool, Progress& progress);
+  // Fills the depth plane, then the normals (from the normal image or reconstructed from depth),
+  // then the `extras` (FrameExtras) asked for; the planes of the others are left empty.
+  void build(const FrameInputs& in, TilePool& pool, Progress& progress,
+             unsigned extras = kAllFrameExtras);
   // The depth plane (and extra layers) alone: what a frame estimated at half resolution needs
   // of the full one. It has no normal plane (one a previous run kept is freed).
   void build_depth(const FrameInputs& in, TilePool& pool, Progress& progress);
 
   // This frame at half resolution: each 2x2 block becomes one pixel with the depth and normal
   // of its nearest geometry pixel (background if it has none), seen through full.camera()
-  // made twice as coarse. `full` needs its depth only; the normals are read from `in`.
-  void downsample(const Frame& full, const FrameInputs& in, TilePool& pool, Progress& progress);
+  // made twice as coarse. `full` needs its depth only; the normals are read from `in`. `extras`
+  // as for build.
+  void downsample(const Frame& full, const FrameInputs& in, TilePool& pool, Progress& progress,
+                  unsigned extras = kAllFrameExtras);
 
   int width() const { return width_; }
   int height() const { return height_; }
@@ -183,10 +196,10 @@ class Frame {
   // the pixel's ray lies per unit of planar depth it lies behind or in front of the surface
   // (|normal . ray| with the ray's z = -1); 0 on background. Null without extra layers.
   const float* plane_distance_scale_plane() const {
-    return extra_layers_ > 0 ? plane_distance_scale_.data() : nullptr;
+    return plane_distance_scale_.empty() ? nullptr : plane_distance_scale_.data();
   }
   float plane_distance_scale(int x, int y) const {
-    return extra_layers_ > 0 ? plane_distance_scale_[index(x, y)] : 0.0f;
+    return plane_distance_scale_.empty() ? 0.0f : plane_distance_scale_[index(x, y)];
   }
 
   // Without extra layers, per pixel: the planar depth at which the pixel's ray meets the surfaces
@@ -232,6 +245,9 @@ class Frame {
                          const float* ny, const float* nz, uint32_t* usable, uint32_t* mixed,
                          uint32_t* out) const;
 
+  // The extras (FrameExtras) from the finished depth, normal and layer planes; the planes of
+  // the others are freed.
+  void derive_extras(unsigned extras, TilePool& pool, Progress& progress);
   // Fills last_thickness_ from the finished depth and layer planes.
   void infer_last_thickness(TilePool& pool, Progress& progress);
   void measure_post_thickness(TilePool& pool, Progress& progress);

@@ -539,11 +539,12 @@ void Job::run() {
       (resolution == "auto" && double(width) * double(height) >= kHalfResolutionPixels);
   Frame& frame = frame_;
   frame.reset(camera, width, height, in.extra_layers);
+  const VariantInfo& variant_info = find_variant(v.get_string("variant"));
   if (half_resolution) {
     frame.build_depth(in, tiles, progress);
-    half_frame_.downsample(frame, in, tiles, progress);
+    half_frame_.downsample(frame, in, tiles, progress, variant_info.frame_extras);
   } else {
-    frame.build(in, tiles, progress);
+    frame.build(in, tiles, progress, variant_info.frame_extras);
   }
   const Frame& seen = half_resolution ? half_frame_ : frame;
   // With one layer at most five image-size buffers: the full frame's four planes (depth, normal,
@@ -554,7 +555,7 @@ void Job::run() {
   const size_t estimates = size_t(seen.width()) * size_t(seen.height());
   if (visibility_.capacity() > estimates) std::vector<float>().swap(visibility_);
 
-  const std::unique_ptr<Variant> variant = find_variant(v.get_string("variant")).create(v, seen);
+  const std::unique_ptr<Variant> variant = variant_info.create(v, seen);
   progress.set_stage(0.05, 0.95);
   std::vector<float>& visibility = visibility_;
   visibility.assign(estimates, 1.0f);

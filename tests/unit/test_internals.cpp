@@ -318,23 +318,20 @@ struct PreparedFrame {
 
 // A corner (two walls) on a floor: creases, silhouettes and open floor in one frame. 101 pixels
 // wide, so rows end in a partial vector on every SIMD width.
-// With `layers`, a box floats in front of the corner, a slab behind it, and the frame gets the
-// 2nd and 3rd hits:
-// `facing` says whether their facing images are given or taken to alternate.
+// A box floats in front of the corner, a slab behind it. With `layers` the frame gets the 2nd and
+// 3rd hits: `facing` says whether their facing images are given or taken to alternate.
 void prepare(PreparedFrame& out, const Camera& cam, const char* variant, bool layers = false,
-             bool facing = true, bool tilted = false) {
+             bool facing = true, bool tilted = false, unsigned extras = ssao::kAllFrameExtras) {
   Camera c = cam;
   c.width = 101;
   c.height = 67;
   std::vector<Solid> solids = {
       {{{0, -1.0, 0}, {0, 1, 0}}},
-      {{{0.3, 0, -6}, normalized({1, 0, 1})}, {{0.3, 0, -6}, normalized({-1, 0, 1})}}};
-  if (layers) {
-    solids.push_back(box({-0.9, -0.8, -5.2}, {-0.1, 0.2, -4.6}));
-    // A thin slab behind the box that shows beside it: where the box hides it, its front is
-    // the 3rd hit and its thickness is measured beside the box (Frame::last_thickness).
-    solids.push_back(box({-0.6, -0.9, -5.6}, {0.2, 0.5, -5.5}));
-  }
+      {{{0.3, 0, -6}, normalized({1, 0, 1})}, {{0.3, 0, -6}, normalized({-1, 0, 1})}},
+      box({-0.9, -0.8, -5.2}, {-0.1, 0.2, -4.6}),
+      // A thin slab behind the box that shows beside it: where the box hides it, its front is
+      // the 3rd hit and its thickness is measured beside the box (Frame::last_thickness).
+      box({-0.6, -0.9, -5.6}, {0.2, 0.5, -5.5})};
   static Scene s;  // the frame's images must outlive build(): kept until the next prepare()
   s = ray_cast(c, solids);
   if (tilted) {  // the floor's normals tilted as a smooth-shaded mesh's (Frame::surface_normal)
@@ -368,7 +365,7 @@ void prepare(PreparedFrame& out, const Camera& cam, const char* variant, bool la
   ssao::TilePool pool(2);
   ssao::Progress progress(nullptr, nullptr);
   out.frame.reset(camera_model(c, s.width, s.height), s.width, s.height, in.extra_layers);
-  out.frame.build(in, pool, progress);
+  out.frame.build(in, pool, progress, extras);
 }
 
 std::vector<float> estimate(const PreparedFrame& p, bool reference,
@@ -573,6 +570,37 @@ TEST(FastPath, EveryVariantMatchesItsScalarReference) {
       // 1e-4). A real divergence changes most pixels, and by far more.
       EXPECT_LE(differ, geometry / 200) << info.name;
       EXPECT_LE(worst, 0.5) << info.name;
+    }
+  }
+}
+
+TEST(Frame, EachVariantReadsOnlyTheExtrasItDeclares) {
+  // The job builds only the planes a variant declares (VariantInfo::frame_extras): its AO must be
+  // the same bits as from a frame with every plane, and the skipped planes must be absent.
+  for (const ssao::VariantInfo& info : ssao::variant_registry()) {
+    for (const bool layers : {false, true}) {
+      for (const Camera& cam : {Camera{}, Camera{true}}) {
+        PreparedFrame all, declared;
+        prepare(all, cam, info.name, layers);
+        prepare(declared, cam, info.name, layers, true, false, info.frame_extras);
+        const ssao::Frame& f = declared.frame;
+        if ((info.frame_extras & ssao::kSolidThickness) == 0) {
+          EXPECT_EQ(f.last_thickness_plane(), nullptr) << info.name;
+        }
+        if ((info.frame_extras & ssao::kPlaneDistanceScale) == 0) {
+          EXPECT_EQ(f.plane_distance_scale_plane(), nullptr) << info.name;
+        }
+        if ((info.frame_extras & ssao::kCarriedSurfaces) == 0) {
+          EXPECT_EQ(f.carried_depth_plane(), nullptr) << info.name;
+        }
+        for (const bool reference : {false, true}) {
+          const auto expected = estimate(all, reference, whole(all.frame));
+          const auto got = estimate(declared, reference, whole(f));
+          EXPECT_EQ(std::memcmp(expected.data(), got.data(), expected.size() * sizeof(float)), 0)
+              << info.name << (layers ? " +layers" : "") << (cam.ortho ? " ortho" : " persp")
+              << (reference ? " (scalar reference)" : "");
+        }
+      }
     }
   }
 }

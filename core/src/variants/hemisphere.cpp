@@ -1147,7 +1147,8 @@ const VariantInfo kHemisphereVariant = {
     "samples|steps|sample_clustering|thickness|bias|seed",
     [](const ParamValues& v, const Frame& f) -> std::unique_ptr<Variant> {
       return std::make_unique<Hemisphere>(v, f);
-    }};
+    },
+    kSolidThickness | kPlaneDistanceScale | kCarriedSurfaces};
 
 }  // namespace ssao
 #endif  // HWY_ONCE

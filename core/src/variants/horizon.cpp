@@ -297,6 +297,7 @@ const VariantInfo kHorizonVariant = {
     "slices|steps|thickness|bias|seed",
     [](const ParamValues& v, const Frame&) -> std::unique_ptr<Variant> {
       return std::make_unique<Horizon>(v);
-    }};
+    },
+    kSolidThickness};
 
 }  // namespace ssao

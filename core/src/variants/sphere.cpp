@@ -94,6 +94,7 @@ const VariantInfo kSphereVariant = {
     "samples|sample_clustering|sphere_mode|bias|seed",
     [](const ParamValues& v, const Frame&) -> std::unique_ptr<Variant> {
       return std::make_unique<Sphere>(v);
-    }};
+    },
+    0u};
 
 }  // namespace ssao

@@ -89,8 +89,10 @@ const VariantInfo kUnsharpVariant = {
     "unsharp",
     "depth unsharp masking: the depth around the pixel against its own (Luft et al. 2006), "
     "depth only, cost independent of the radius",
-    "", [](const ParamValues& v, const Frame& f) -> std::unique_ptr<Variant> {
+    "",
+    [](const ParamValues& v, const Frame& f) -> std::unique_ptr<Variant> {
       return std::make_unique<Unsharp>(v, f);
-    }};
+    },
+    0u};
 
 }  // namespace ssao

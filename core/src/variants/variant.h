@@ -34,6 +34,8 @@ struct VariantInfo {
   // The parameters this variant reads beyond the ones every variant reads, '|'-separated.
   const char* parameters;
   std::unique_ptr<Variant> (*create)(const ParamValues& values, const Frame& frame);
+  // The planes it reads beyond depth and normals (FrameExtras): the job builds only these.
+  unsigned frame_extras;
 };
 
 // Every variant, in the order front ends list them.

@@ -417,9 +417,11 @@ const VariantInfo kVolumetricVariant = {
     "volumetric",
     "line-integral obscurance: the part of a sphere around the receiver behind the depth "
     "buffer, along view rays (Loos & Sloan 2010), depth only",
-    "samples|thickness|seed", [](const ParamValues& v, const Frame&) -> std::unique_ptr<Variant> {
+    "samples|thickness|seed",
+    [](const ParamValues& v, const Frame&) -> std::unique_ptr<Variant> {
       return std::make_unique<Volumetric>(v);
-    }};
+    },
+    0u};
 
 }  // namespace ssao
 #endif  // HWY_ONCE
