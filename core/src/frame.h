@@ -254,6 +254,15 @@ class Frame {
   // Where a run of pixels on one surface ends at (x, y), the surface dropping away to (x + dx,
   // y + dy): bounds the depth of its last face's solid (last_thickness_plane, negated).
   void bound_by_side_face(int x, int y, int dx, int dy, int run);
+  // The same where the run's last face, seen at a grazing angle, is the side of the face before it
+  // (from pixel `first` on, normal n), shown up to the end.
+  void bound_by_shown_side(int x, int y, int dx, int dy, int run, int first, Vec3 n);
+  void bound_up_to_next_face(int x, int y, int dx, int dy, int run, int face, Vec3 n, float bound);
+  // Whether pixel k in from a run's end (x, y) begins a face other than n's: its normal differs
+  // and its inner neighbour (k + 1, inside the run) shares it.
+  bool face_begins(int x, int y, int dx, int dy, int k, Vec3 n) const;
+  // How far in from the run's end the face before the side is looked for.
+  static constexpr int kShownSidePixels = 16;
   // A side face this deep would reach this far past the face's edge on screen: half the way to
   // the next pixel's centre, the edge's expected place between the two.
   static constexpr float kSideFacePixels = 0.5f;
