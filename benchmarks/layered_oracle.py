@@ -75,8 +75,8 @@ def read_layers(path, depth, one_layer):
     visible = flicker.merged_with_band(planes[0], depth, band)
     hits, facing = flicker.hits_behind(visible, planes[1:len(extra) + 1], planes[len(extra) + 1:])
     back = facing > 0.5
-    if one_layer:
-        hits[:] = flicker.NO_HIT
+    if one_layer:  # no hits behind (a NO_HIT entry would read as a face closing the solid)
+        hits, back = hits[..., :0], back[..., :0]
         inside = np.zeros(visible.shape, bool)
         inside[band:band + depth.shape[0], band:band + depth.shape[1]] = True
         visible = np.where(inside, visible, flicker.NO_HIT)
