@@ -494,17 +494,16 @@ HWY_NOINLINE void hemisphere_row_of(const HemisphereRowArgs& a, int y, int x0, i
       // The previous point of the direction (the receiver first) and, on lanes where it lay
       // hidden behind the visible surface of its pixel, that surface's tangent plane
       // dot(x, n) = w (Hemisphere::crossing).
-      [[maybe_unused]] VF ax = px, ay = py, az = pz;
-      [[maybe_unused]] auto previous_hidden = none;
-      [[maybe_unused]] VF pnx = zero, pny = zero, pnz = zero, pw = zero;
+      VF ax = px, ay = py, az = pz;
+      auto previous_hidden = none;
+      VF pnx = zero, pny = zero, pnz = zero, pw = zero;
       // Between the previous point and sample (sx, sy, sz) the direction may have passed through
       // a surface that neither lies in (a 2 cm board between two steps): the plane of the
       // surface the sample is hidden behind (lanes `hidden`, above the tangent plane), else the
       // previous point's (Hemisphere::crossing). The plane of the sample's surface (q, at
       // `index`) is read into (hnx, hny, hnz, hw) on the lanes `planes`.
-      [[maybe_unused]] const auto cross = [&](auto hidden, auto planes, VI index, VF qxv, VF qyv,
-                                              VF qzv, VF sx, VF sy, VF sz, VF extend, VF& hnx,
-                                              VF& hny, VF& hnz, VF& hw) {
+      const auto cross = [&](auto hidden, auto planes, VI index, VF qxv, VF qyv, VF qzv, VF sx,
+                             VF sy, VF sz, VF extend, VF& hnx, VF& hny, VF& hnz, VF& hw) {
         if (hn::AllFalse(df, hn::Or(planes, hn::And(previous_hidden, hn::Lt(blocked, one))))) {
           return;
         }
@@ -528,8 +527,7 @@ HWY_NOINLINE void hemisphere_row_of(const HemisphereRowArgs& a, int y, int x0, i
         }
       };
       // The sample becomes the previous point.
-      [[maybe_unused]] const auto advance = [&](VF sx, VF sy, VF sz, auto hidden, VF hnx, VF hny,
-                                                VF hnz, VF hw) {
+      const auto advance = [&](VF sx, VF sy, VF sz, auto hidden, VF hnx, VF hny, VF hnz, VF hw) {
         ax = sx, ay = sy, az = sz;
         previous_hidden = hidden;
         pnx = hnx, pny = hny, pnz = hnz, pw = hw;
