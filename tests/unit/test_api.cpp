@@ -39,6 +39,21 @@ TEST(Api, NullHandlesAndPointersAreRejected) {
   EXPECT_EQ(ssao_param_info(0, nullptr), SSAO_ERROR_INVALID_ARGUMENT);
 }
 
+TEST(Api, AnOverlongMessageIsCutAndMarked) {
+  // The per-thread message has a fixed size (api.cpp says why): a longer one keeps its start and
+  // ends in "...", and the next short message replaces it whole.
+  Job job;
+  const std::string name(10000, 'x');
+  EXPECT_EQ(ssao_job_set_float(job.get(), name.c_str(), 1.0), SSAO_ERROR_INVALID_ARGUMENT);
+  const std::string cut = ssao_last_error();
+  EXPECT_EQ(cut.size(), 4095u);
+  EXPECT_EQ(cut.rfind("unknown parameter 'xxx", 0), 0u) << cut.substr(0, 40);
+  EXPECT_EQ(cut.substr(cut.size() - 3), "...");
+  EXPECT_EQ(ssao_job_set_float(job.get(), "radus", 1.0), SSAO_ERROR_INVALID_ARGUMENT);
+  EXPECT_TRUE(contains(ssao_last_error(), "unknown parameter 'radus'"));
+  EXPECT_LT(std::strlen(ssao_last_error()), 200u);
+}
+
 TEST(Api, ParameterErrorsNameTheParameter) {
   Job job;
   EXPECT_EQ(ssao_job_set_float(job.get(), "radus", 1.0), SSAO_ERROR_INVALID_ARGUMENT);

@@ -112,7 +112,8 @@ SSAO_API int ssao_version(void);
 /* Returns a static description of a status code. */
 SSAO_API const char* ssao_status_string(ssao_status status);
 /* Returns the message of the last failed call on this thread, "" if none. Valid until the next
-   failing call on this thread. */
+   failing call on this thread. At most 4095 characters: a longer message is cut, ending in "...".
+ */
 SSAO_API const char* ssao_last_error(void);
 
 /* Returns the number of parameters; index them with ssao_param_info(). */
