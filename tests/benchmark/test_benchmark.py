@@ -273,6 +273,33 @@ class CropsTest(unittest.TestCase):
         self.assertLess(float(np.abs(band - reference)[10:-10, 10:-10].max()), 1e-9)
 
 
+class EdgeSidesTest(unittest.TestCase):
+    """benchmarks/edge_sides.py sorts edge pixels by side and rings, on a made-up depth image."""
+
+    def test_a_square_in_front_of_a_wall(self):
+        import numpy as np
+        import edge_sides
+        depth = np.full((40, 60), 10.0)
+        depth[10:20, 20:30] = 5.0  # a square nearer than the wall
+        depth[:, 59] = np.inf  # sky down the right side: a jump to it is no edge
+        geometry = np.isfinite(depth)
+        near, far = edge_sides.edge_sides(depth, geometry)
+        # The square's border (36 pixels) is the near side, the wall's 40 pixels along it the far.
+        self.assertEqual(int(near.sum()), 36)
+        self.assertEqual(int(far.sum()), 40)
+        self.assertTrue(near[10, 20] and far[9, 20] and far[15, 30] and not far[9, 19])
+        self.assertFalse((near | far)[:, 55:].any())
+        rings = edge_sides.far_rings(near, far, geometry)
+        self.assertEqual(len(rings), edge_sides.RINGS)
+        # Ring k: the wall k - 1 steps (4-connected) out from the square's outline.
+        self.assertTrue(rings[1][8, 25] and rings[3][6, 25] and rings[1][9, 19])
+        self.assertFalse(rings[1][9, 25] or rings[2][8, 25])
+        for a in range(len(rings)):
+            for b in range(a + 1, len(rings)):
+                self.assertFalse((rings[a] & rings[b]).any())
+            self.assertFalse((rings[a] & near).any())
+
+
 def main():
     parser = argparse.ArgumentParser()
     parser.add_argument("--build-dir", required=True)
