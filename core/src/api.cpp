@@ -5,6 +5,7 @@
 #include <cstring>
 #include <new>
 #include <string>
+#include <string_view>
 
 #include "error.h"
 #include "job.h"
@@ -21,14 +22,16 @@ namespace {
 constexpr size_t kLastErrorSize = 4096;
 thread_local char last_error[kLastErrorSize];
 
-ssao_status fail(ssao_status status, const char* message) {
-  const size_t length = std::strlen(message);
-  if (length < kLastErrorSize) {
-    std::memcpy(last_error, message, length + 1);
-  } else {
-    std::memcpy(last_error, message, kLastErrorSize - 4);
-    std::memcpy(last_error + kLastErrorSize - 4, "...", 4);
-  }
+// A C string of at most size - 1 characters (size > 0).
+void copy_truncated(std::string_view value, char* out, size_t size) {
+  const size_t n = std::min(size - 1, value.size());
+  std::memcpy(out, value.data(), n);
+  out[n] = '\0';
+}
+
+ssao_status fail(ssao_status status, std::string_view message) {
+  copy_truncated(message, last_error, kLastErrorSize);
+  if (message.size() >= kLastErrorSize) std::memcpy(last_error + kLastErrorSize - 4, "...", 4);
   return status;
 }
 
@@ -46,13 +49,6 @@ ssao_status guarded(Fn&& fn) {
   } catch (...) {
     return fail(SSAO_ERROR_INTERNAL, "unknown internal error");
   }
-}
-
-// A C string of at most size - 1 characters (size > 0).
-void copy_truncated(const std::string& value, char* out, size_t size) {
-  const size_t n = std::min(size - 1, value.size());
-  std::memcpy(out, value.data(), n);
-  out[n] = '\0';
 }
 
 ssao::Job& checked(ssao_job job) {
