@@ -111,16 +111,21 @@ bool on_one_surface(float a, float b) {
 // kOffSurfaceStep of the depth and kStepOverSlope times the surface's own step on either side.
 // A slat 0.3 in front of a wall at a depth of 6.4 is 4 % nearer; a surface seen at a grazing
 // angle steps as far from pixel to pixel, but steadily. A step the other way is no slope: it is
-// the far side of something a pixel wide.
+// the far side of something a pixel wide; nor is one more than kStepOverSlope times this one: a
+// post one pixel wide between a nearer column and the wall 4 % behind it (`thin` on a camera
+// move: the post, read as a part of the wall, kept the assumed thickness in the frames where
+// the column hid the rest of it, and the wall beside it went dark and light from frame to frame).
+constexpr float kOffSurfaceStep = 0.01f;
 bool steps_off(float a, float b, float c, float d) {
-  constexpr float kOffSurfaceStep = 0.01f, kStepOverSlope = 4.0f;
+  constexpr float kStepOverSlope = 4.0f;
   const float step = c - b;
   if (!(std::fabs(step) > kOffSurfaceStep * std::min(b, c))) return false;
   const auto slope = [&](float from, float to) {
     if (std::isnan(from + to) || from == Frame::kBackground || to == Frame::kBackground) {
       return 0.0f;
     }
-    return (to - from) * step > 0.0f ? std::fabs(to - from) : 0.0f;
+    const float steady = (to - from) * step > 0.0f ? std::fabs(to - from) : 0.0f;
+    return steady > kStepOverSlope * std::fabs(step) ? 0.0f : steady;
   };
   return std::fabs(step) > kStepOverSlope * std::max(slope(a, b), slope(c, d));
 }
@@ -252,6 +257,28 @@ void Frame::find_carried_surfaces(TilePool& pool, Progress& progress) {
   });
 }
 
+namespace {
+// How many pixels the run [begin, end) of `row` may go on behind the nearer surface past its end
+// in direction `dir` (1: after it, -1: before it): up to where a surface shows that is farther
+// than the run would be there, going on at its mean slope, by more than steps_off's least step
+// off a surface (or background). -1 where it may go on further: the frame's edge, a surface about
+// as deep as the run (the run showing again), or none within kHiddenSearch pixels.
+int hidden_past(const float* row, int width, int begin, int end, int dir) {
+  constexpr int kHiddenSearch = 64;
+  const int last = dir > 0 ? end - 1 : begin;
+  const float beside = row[last], margin = kOffSurfaceStep * beside;
+  const float slope = std::fabs(row[end - 1] - row[begin]) / float(std::max(end - begin - 1, 1));
+  for (int k = 1; k <= kHiddenSearch; ++k) {
+    const int x = last + k * dir;
+    if (x < 0 || x >= width) return -1;
+    const float gone_on = beside + slope * float(k);
+    if (row[x] > gone_on + margin) return k - 1;
+    if (!(row[x] < gone_on - margin)) return -1;
+  }
+  return -1;
+}
+}  // namespace
+
 // Along each row, a run of pixels on one surface (for_each_run) with a farther surface or
 // background just past both ends is something narrow standing in front: a post, a leg, a
 // column. Its depth is taken from its width, as a round or square post's: the thickness fade
@@ -265,8 +292,13 @@ void Frame::find_carried_surfaces(TilePool& pool, Progress& progress) {
 // moves), and it is narrower than that. Measuring such runs as they are flickered (`thin`'s
 // 320x180 camera move, occluded flicker 0.0251 without the measure, 0.0313 reading every run),
 // and leaving them out switched a 3 px slat between that depth and the assumed thickness from
-// frame to frame (0.0349; 0.0265 taking them as 4 px wide). A run at the frame's edge, or with
-// a nearer surface past an end, says nothing (0).
+// frame to frame (0.0349; 0.0265 taking them as 4 px wide). A run with a nearer surface past an
+// end may go on behind it; where a farther surface than the run would be there shows past the
+// nearer one (hidden_past), the run ends behind it and is at most that much wider: a post partly
+// hidden by a column before it (`thin` on a camera move, occluded flicker 0.0267 -> 0.0176 with
+// steps_off's steadiness: read as unmeasured, such a post kept the assumed thickness, reaching
+// the wall 22 cm behind it, in the frames where the column hid part of it). A run at the frame's
+// edge, or that may go on behind a nearer surface, says nothing (0).
 // Where a run along a row or a column ends in a drop, the face there bounds its solid's depth
 // besides (bound_by_side_face): a rail or a board whose side a deeper solid would show.
 void Frame::measure_post_thickness(TilePool& pool, Progress& progress) {
@@ -279,9 +311,11 @@ void Frame::measure_post_thickness(TilePool& pool, Progress& progress) {
       std::fill_n(out, width_, 0.0f);
       const auto depth_at = [&](int x) { return row[x]; };
       for_each_run(width_, depth_at, [&](int x, int end, bool left, bool right) {
-        if (left && right) {
+        const int before = left ? 0 : hidden_past(row, width_, x, end, -1);
+        const int after = right ? 0 : hidden_past(row, width_, x, end, 1);
+        if (before >= 0 && after >= 0) {
           const auto [nearest, farthest] = std::minmax_element(row + x, row + end);
-          const float width = float(std::max(end - x, kPostWidthPixels)) *
+          const float width = float(std::max(end - x + before + after, kPostWidthPixels)) *
                               camera_.pixel_footprint(0.5f * (*nearest + *farthest));
           std::fill(out + x, out + end, kDepthPerWidth * std::max(width, *farthest - *nearest));
         }
