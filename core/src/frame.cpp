@@ -260,7 +260,8 @@ void Frame::find_carried_surfaces(TilePool& pool, Progress& progress) {
 namespace {
 // How many pixels the run [begin, end) of `row` may go on behind the nearer surface past its end
 // in direction `dir` (1: after it, -1: before it): up to where a surface shows that is farther
-// than the run would be there, going on at its mean slope, by more than steps_off's least step
+// than the run would be there, receding at its mean steepness (either way it slopes: the run is
+// never taken to end where it might only have turned away), by more than steps_off's least step
 // off a surface (or background). -1 where it may go on further: the frame's edge, a surface about
 // as deep as the run (the run showing again), or none within kHiddenSearch pixels.
 int hidden_past(const float* row, int width, int begin, int end, int dir) {
