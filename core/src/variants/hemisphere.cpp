@@ -266,20 +266,23 @@ HWY_INLINE VF between_lanes(const HemisphereRowArgs& a, const LaneProjection<VF>
 // Without extra layers: 1 / the depth of the visible surface's solid at pixel `index` (point q)
 // for the receiver p, the assumed thickness or, where the frame bounds it there, the bound if
 // less (Frame::last_thickness_seen_from: a side-face bound, stored negated, for a receiver
-// behind the face's tangent plane only).
-template <class VF, class VI>
-HWY_INLINE VF inv_visible_thickness_lanes(const HemisphereRowArgs& a, VI index, VF px, VF py, VF pz,
-                                          VF qx, VF qy, VF qz) {
+// behind the face's tangent plane only). Read on the lanes `needed` only, those whose point lies
+// behind the surface: in front of it the thickness weight is 1 whatever the depth.
+template <class M, class VF, class VI>
+HWY_INLINE VF inv_visible_thickness_lanes(const HemisphereRowArgs& a, M needed, VI index, VF px,
+                                          VF py, VF pz, VF qx, VF qy, VF qz) {
   namespace hn = hwy::HWY_NAMESPACE;
   const hn::DFromV<VF> df;
   const hn::RebindToSigned<decltype(df)> di;
-  if (a.last_thickness == nullptr) return hn::Set(df, 1.0f / a.thickness);
+  if (a.last_thickness == nullptr || hn::AllFalse(df, needed)) {
+    return hn::Set(df, 1.0f / a.thickness);
+  }
   const VF signed_measure = hn::GatherIndex(df, a.last_thickness, index);
   const VF measured = hn::Abs(signed_measure);
   auto known = hn::Gt(signed_measure, hn::Zero(df));
   // A bound no less than the assumed thickness changes nothing: no normal to read for it.
-  const auto sided = hn::And(hn::Lt(signed_measure, hn::Zero(df)),
-                             hn::Gt(signed_measure, hn::Set(df, -a.thickness)));
+  const auto sided = hn::And(needed, hn::And(hn::Lt(signed_measure, hn::Zero(df)),
+                                             hn::Gt(signed_measure, hn::Set(df, -a.thickness))));
   if (!hn::AllFalse(df, sided)) {
     VF nx, ny, nz;
     decode_directions(df, hn::GatherIndex(di, reinterpret_cast<const int32_t*>(a.normals), index),
@@ -392,9 +395,9 @@ HWY_INLINE VF beyond_frame_lanes(const HemisphereRowArgs& a, const LaneProjectio
   if (hn::AllFalse(df, counts)) return zero;
   if (a.extra_layers == 0) {  // the visible surface, within its solid's depth
     return hn::IfThenElseZero(
-        counts, thickness_weight_lanes(
-                    ahead, inv_visible_thickness_lanes<VF>(a, index, px, py, pz, ray_x * q_scale,
-                                                           ray_y * q_scale, hn::Neg(qd))));
+        counts, thickness_weight_lanes(ahead, inv_visible_thickness_lanes(
+                                                  a, counts, index, px, py, pz, ray_x * q_scale,
+                                                  ray_y * q_scale, hn::Neg(qd))));
   }
   // The border pixel's hits go on beyond the frame too: the sample, `ahead` behind the plane,
   // stands where a point that far behind the border pixel's visible surface stands among them.
@@ -578,7 +581,8 @@ HWY_NOINLINE void hemisphere_row_of(const HemisphereRowArgs& a, int y, int x0, i
           const VF covered =
               hn::Min(one, hn::Max(zero, cone_part_lanes(behind, hn::LoadU(df, cone))));
           const VF thick = thickness_weight_lanes(
-              behind, inv_visible_thickness_lanes<VF>(a, index, px, py, pz, qxv, qyv, qzv));
+              behind, inv_visible_thickness_lanes(a, hn::And(above, hn::Gt(behind, zero)), index,
+                                                  px, py, pz, qxv, qyv, qzv));
           blocked = hn::Max(blocked, hn::IfThenElseZero(above, covered * thick));
           // Hidden beyond that solid's reach: the surface beyond the nearest silhouette, carried
           // on behind the object (Frame::carried_depth), occludes within the assumed thickness
