@@ -389,6 +389,35 @@ TEST(Layers, OneLayerMeasuresAPostPartlyHiddenByAColumn) {
 // the underside would show below it where the wall does. The wall above and below it is
 // darkened only as much as by something that thin, where the assumed thickness (half the
 // radius) made it a block reaching the wall.
+// A shelf board 2 cm thick and 0.3 deep out of a wall, seen from the front a little above its
+// level: the wall just above the board sees the board's top face as a sliver a pixel or two tall.
+// A direction down from a receiver there meets the board before its first step, which lies past
+// the board's front edge, in front of what its pixel shows: neither point is hidden, so neither
+// the steps nor the crossing test see the board (Hemisphere::halfway).
+TEST(Layers, OneLayerSeesABoardBeforeTheFirstStep) {
+  Camera cam;
+  cam.width = 128, cam.height = 96;
+  const double wall_z = -3.0, board_top = -0.28;
+  const std::vector<Solid> solids = {{{{0, 0, wall_z}, {0, 0, 1}}},
+                                     box({-10, board_top - 0.02, wall_z}, {10, board_top, -2.7})};
+  double mean_reference = 0;
+  const Error one = one_layer_error_where(
+      cam, solids, 4, 1, 300,
+      [&](const V3& p) {
+        return std::fabs(p.z - wall_z) < 1e-6 && p.y > board_top && p.y < board_top + 0.3;
+      },
+      &mean_reference);
+  std::printf(
+      "[ measure  ] wall above a shelf board, %d px (ray-traced mean %.4f): one layer RMSE %.4f "
+      "bias %+.4f\n",
+      one.count, mean_reference, one.rmse, one.bias);
+  EXPECT_LT(mean_reference, 0.9);  // the board occludes: the test measures something
+  // Without the point halfway to the first step: RMSE 0.1683, bias +0.1666; with it 0.1419,
+  // +0.1399. Still light: one layer sees neither the board's underside nor its depth.
+  EXPECT_LT(one.rmse, 0.155);
+  EXPECT_LT(one.bias, 0.155);
+}
+
 TEST(Layers, OneLayerBoundsARailByTheSideItDoesNotShow) {
   Camera cam;
   cam.width = 128, cam.height = 96;

@@ -407,6 +407,17 @@ HWY_INLINE VF beyond_frame_lanes(const HemisphereRowArgs& a, const LaneProjectio
   return hn::IfThenElseZero(hn::And(counts, entered), solid);
 }
 
+// What a point's pixel shows (hemisphere_row_of's visible_surface): the pixel's index, the
+// visible surface's depth, its pixel's ray (x, y at unit depth) and view position, how far it
+// lies in front of the point (`behind` > 0: the point is hidden), whether it lies above the
+// receiver's tangent plane, and the weight with which it occludes the point.
+template <class VF, class VI, class M>
+struct VisibleSurface {
+  VI index;
+  VF depth, ray_x, ray_y, x, y, z, behind, weight;
+  M above;
+};
+
 // Visibility of pixels [x0, x1) of row y into out[0 .. x1 - x0); kLayers: the frame has extra
 // depth layers (compiled apart, so that the one-layer loop carries none of their state).
 template <bool kLayers>
@@ -419,6 +430,7 @@ HWY_NOINLINE void hemisphere_row_of(const HemisphereRowArgs& a, int y, int x0, i
   const CameraIntrinsics& cam = a.camera;
   const VF inf = hn::Set(df, std::numeric_limits<float>::infinity());
   const VF zero = hn::Zero(df), one = hn::Set(df, 1.0f), half = hn::Set(df, 0.5f);
+  using Mask = hn::Mask<decltype(df)>;
   const VF inv_thickness = hn::Set(df, 1.0f / a.thickness);
   const VF radius = hn::Set(df, a.radius);
   const LaneProjection<VF> project(cam, a.width, a.height);
@@ -491,6 +503,30 @@ HWY_NOINLINE void hemisphere_row_of(const HemisphereRowArgs& a, int y, int x0, i
     const float* offset = row_offsets;
     const float* cone = row_cones;
     const auto none = hn::Lt(one, zero);  // all false
+    // One layer: the visible surface at the pixel (pu, pv) of a point at view z on lanes `on`
+    // (Frame::position), and the weight with which it occludes the point where it lies above
+    // the tangent plane: the part of the point's cone behind it (Hemisphere::covered, by the
+    // depth difference; 0.5 / the cone's width: half_inv_width) within its solid's depth (the
+    // assumed thickness, or a post's).
+    const auto visible_surface = [&](Mask on, VF pu, VF pv, VF z, VF half_inv_width) {
+      VisibleSurface<VF, VI, Mask> q;
+      const VI qx = hn::ConvertTo(di, hn::IfThenElseZero(on, pu));
+      const VI qy = hn::ConvertTo(di, hn::IfThenElseZero(on, pv));
+      q.index = qy * hn::Set(di, a.width) + qx;
+      q.depth = hn::GatherIndex(df, a.depth, q.index);
+      const VF q_scale = cam.orthographic ? one : q.depth;
+      project.pixel_ray(qx, qy, q.ray_x, q.ray_y);
+      q.x = q.ray_x * q_scale, q.y = q.ray_y * q_scale, q.z = hn::Neg(q.depth);
+      q.behind = q.z - z;  // > 0: the visible surface is in front of the point
+      const VF level = hn::MulAdd(q.x, gx, hn::MulAdd(q.y, gy, q.z * gz));
+      q.above = hn::And(hn::And(on, hn::Lt(q.depth, inf)), hn::Gt(level, plane_level));
+      const VF covered = hn::Min(one, hn::Max(zero, cone_part_lanes(q.behind, half_inv_width)));
+      const VF thick = thickness_weight_lanes(
+          q.behind, inv_visible_thickness_lanes(a, hn::And(q.above, hn::Gt(q.behind, zero)),
+                                                q.index, px, py, pz, q.x, q.y, q.z));
+      q.weight = hn::IfThenElseZero(q.above, covered * thick);
+      return q;
+    };
     for (int k = 0; k < a.directions; ++k) {
       VF blocked = zero;
       auto seen = none;
@@ -535,6 +571,21 @@ HWY_NOINLINE void hemisphere_row_of(const HemisphereRowArgs& a, int y, int x0, i
         previous_hidden = hidden;
         pnx = hnx, pny = hny, pnz = hnz, pw = hw;
       };
+      // One layer: on lanes `unhidden` the receiver's first step (sx, sy, sz) lies in front of
+      // what its pixel shows, or outside the frame: a board nearer than it, between the two, is
+      // seen from neither, and the crossing test has no plane to try. The point halfway to it,
+      // as a sample (Hemisphere::halfway).
+      const auto halfway_to_first_step = [&](Mask unhidden, VF sx, VF sy, VF sz) {
+        const auto open = hn::And(unhidden, hn::And(receiver, hn::Lt(blocked, one)));
+        if (hn::AllFalse(df, open)) return;
+        VF mu, mv;
+        const VF mz = (pz + sz) * half;
+        const auto shown = hn::And(open, project((px + sx) * half, (py + sy) * half, mz, mu, mv));
+        if (hn::AllFalse(df, shown)) return;
+        blocked = hn::Max(
+            blocked,
+            visible_surface(shown, mu, mv, mz, hn::LoadU(df, cone + 2 * kLaneTable)).weight);
+      };
       const float* const direction_end = offset + size_t(a.steps) * 3 * kLaneTable;
       const float* const cone_end = cone + size_t(a.steps) * 3 * kLaneTable;
       for (int step = 0; step < a.steps; ++step, offset += 3 * kLaneTable, cone += 3 * kLaneTable) {
@@ -559,31 +610,21 @@ HWY_NOINLINE void hemisphere_row_of(const HemisphereRowArgs& a, int y, int x0, i
         seen = hn::Or(seen, in_front);
         if constexpr (!kLayers) {
           if (hn::AllFalse(df, in_image)) {
+            if (step == 0) halfway_to_first_step(hn::Not(none), sx, sy, sz);
             advance(sx, sy, sz, none, zero, zero, zero, zero);
             continue;
           }
-          const VI qx = hn::ConvertTo(di, hn::IfThenElseZero(in_image, su));
-          const VI qy = hn::ConvertTo(di, hn::IfThenElseZero(in_image, sv));
-          const VI index = qy * hn::Set(di, a.width) + qx;
-          const VF qd = hn::GatherIndex(df, a.depth, index);
-          // The visible surface at that pixel (Frame::position), above the tangent plane: the part
-          // of the sample's cone behind it (Hemisphere::covered, by the depth difference), within
-          // its solid's depth (the assumed thickness, or a post's).
-          const VF q_scale = cam.orthographic ? one : qd;
-          VF ray_x, ray_y;
-          project.pixel_ray(qx, qy, ray_x, ray_y);
-          const VF qxv = ray_x * q_scale, qyv = ray_y * q_scale;
-          const VF qzv = hn::Neg(qd);
-          const VF behind = qzv - sz;  // > 0: the visible surface is in front of the sample
-          const VF level = hn::MulAdd(qxv, gx, hn::MulAdd(qyv, gy, qzv * gz));
-          const auto above =
-              hn::And(hn::And(in_image, hn::Lt(qd, inf)), hn::Gt(level, plane_level));
-          const VF covered =
-              hn::Min(one, hn::Max(zero, cone_part_lanes(behind, hn::LoadU(df, cone))));
-          const VF thick = thickness_weight_lanes(
-              behind, inv_visible_thickness_lanes(a, hn::And(above, hn::Gt(behind, zero)), index,
-                                                  px, py, pz, qxv, qyv, qzv));
-          blocked = hn::Max(blocked, hn::IfThenElseZero(above, covered * thick));
+          const VisibleSurface<VF, VI, Mask> q =
+              visible_surface(in_image, su, sv, sz, hn::LoadU(df, cone));
+          const VI index = q.index;
+          const VF qd = q.depth, qxv = q.x, qyv = q.y, qzv = q.z, behind = q.behind;
+          const VF ray_x = q.ray_x, ray_y = q.ray_y;
+          const auto above = q.above;
+          blocked = hn::Max(blocked, q.weight);
+          if (step == 0) {
+            halfway_to_first_step(hn::Or(hn::Not(in_image), hn::Not(hn::Gt(behind, zero))), sx, sy,
+                                  sz);
+          }
           // Hidden beyond that solid's reach: the surface beyond the nearest silhouette, carried
           // on behind the object (Frame::carried_depth), occludes within the assumed thickness
           // when the receiver lies in front of it and it is above the tangent plane.
@@ -949,6 +990,12 @@ class Hemisphere final : public Variant {
             }
           }
         }
+        // One layer: the receiver's first step lies in front of what its pixel shows (or outside
+        // the frame), so a board nearer than it is seen from neither: the point halfway to it.
+        if (!layered && step == 0 && !hidden && blocked < 1.0f) {
+          blocked = std::max(blocked, halfway(f, p, geometric_normal, min_height,
+                                              (p + sample) * 0.5f, cone->half_inv_width_between));
+        }
         // The last sample in front of a surface above the tangent plane: the direction goes on
         // to the radius, and may reach that surface beyond it.
         const bool ends = layered && step == steps_ - 1 && above && !hidden;
@@ -1102,6 +1149,24 @@ class Hemisphere final : public Variant {
     return saturate(std::max(behind * f.plane_distance_scale(qx, qy) * half_inv_width + 0.5f,
                              end_part(past_end))) *
            weight;
+  }
+
+  // One layer: the point halfway between the receiver and its first step, when that step lies in
+  // front of what its pixel shows, as a sample (a board between them, seen from neither, that
+  // the crossing test cannot find: it takes the plane of a surface a step lies behind). The
+  // visible surface at its pixel, above the receiver's tangent plane (p, normal, min_height),
+  // occludes it by the part of the point's cone (0.5 / its width: half_inv_width) behind it,
+  // within its solid's depth (solid_weight). The vector path's probe in hemisphere_row_of.
+  float halfway(const Frame& f, Vec3 p, Vec3 normal, float min_height, Vec3 point,
+                float half_inv_width) const {
+    int qx, qy;
+    if (!pixel_of_sample(f, point, qx, qy) || !f.is_geometry(qx, qy)) return 0.0f;
+    const Vec3 q = f.position(qx, qy);
+    if (!(dot(q - p, normal) > min_height)) return 0.0f;
+    const float part = saturate((q.z - point.z) * half_inv_width + 0.5f);
+    float entry = Frame::kBackground;
+    const float weight = solid_weight(f, qx, qy, -point.z, p, entry);
+    return entry == Frame::kBackground ? part : part * weight;
   }
 
   // When the last sample b of a direction lies in front of the tangent plane (point q, normal
