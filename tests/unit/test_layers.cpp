@@ -383,12 +383,6 @@ TEST(Layers, OneLayerMeasuresAPostPartlyHiddenByAColumn) {
   EXPECT_LT(one.rmse, 0.065);
 }
 
-// Without extra layers a face bounds its solid's depth by the side face a deeper solid would
-// show (Frame::bound_by_side_face): a rail 0.2 tall and 0.05 deep, above the eye and 0.3 in
-// front of a wall, shows its front and a pixel or so of its underside; were it deeper, more of
-// the underside would show below it where the wall does. The wall above and below it is
-// darkened only as much as by something that thin, where the assumed thickness (half the
-// radius) made it a block reaching the wall.
 // A shelf board 2 cm thick and 0.3 deep out of a wall, seen from the front a little above its
 // level: the wall just above the board sees the board's top face as a sliver a pixel or two tall.
 // A direction down from a receiver there meets the board before its first step, which lies past
@@ -418,6 +412,12 @@ TEST(Layers, OneLayerSeesABoardBeforeTheFirstStep) {
   EXPECT_LT(one.bias, 0.155);
 }
 
+// Without extra layers a face bounds its solid's depth by the side face a deeper solid would
+// show (Frame::bound_by_side_face): a rail 0.2 tall and 0.05 deep, above the eye and 0.3 in
+// front of a wall, shows its front and a pixel or so of its underside; were it deeper, more of
+// the underside would show below it where the wall does. The wall above and below it is
+// darkened only as much as by something that thin, where the assumed thickness (half the
+// radius) made it a block reaching the wall.
 TEST(Layers, OneLayerBoundsARailByTheSideItDoesNotShow) {
   Camera cam;
   cam.width = 128, cam.height = 96;
