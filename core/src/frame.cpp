@@ -278,6 +278,33 @@ int hidden_past(const float* row, int width, int begin, int end, int dir) {
   }
   return -1;
 }
+
+// A solid's thickness from how wide it is: the thickness fade counts a point fully up to the
+// thickness and not at all past twice it, so 2/3 of a round solid's depth.
+constexpr float kDepthPerWidth = 2.0f / 3.0f;
+
+// How deep a rounded solid is at each pixel i of a run [begin, end) on its surface, from the
+// run's drops to a farther surface (a silhouette) before and after it, into out[i - begin] (view
+// units, times kDepthPerWidth; `footprint_at(i)`: pixel i's width in view units). A circle's
+// chord: 2 sqrt(a b) pixels for a pixel a from one drop and b from the other; with one drop (the
+// run may go on behind a nearer surface at its other end), as if the run were the radius,
+// 2 sqrt(a w) for a run w long. Not called without a drop.
+template <class FootprintAt>
+void rounded_depths(int begin, int end, bool drop_before, bool drop_after, FootprintAt footprint_at,
+                    float* out) {
+  const int n = end - begin;
+  const float run = float(n);
+  const auto put = [&](int k, float pixels_squared) {
+    out[k] = kDepthPerWidth * 2.0f * std::sqrt(pixels_squared) * footprint_at(begin + k);
+  };
+  if (drop_before && drop_after) {
+    for (int k = 0; k < n; ++k) put(k, (float(k) + 0.5f) * (run - float(k) - 0.5f));
+  } else if (drop_before) {
+    for (int k = 0; k < n; ++k) put(k, (float(k) + 0.5f) * run);
+  } else {
+    for (int k = 0; k < n; ++k) put(k, (run - float(k) - 0.5f) * run);
+  }
+}
 }  // namespace
 
 // Along each row, a run of pixels on one surface (for_each_run) with a farther surface or
@@ -302,14 +329,18 @@ int hidden_past(const float* row, int width, int begin, int end, int dir) {
 // edge, or that may go on behind a nearer surface, says nothing (0).
 // Where a run along a row or a column ends in a drop, the face there bounds its solid's depth
 // besides (bound_by_side_face): a rail or a board whose side a deeper solid would show.
-void Frame::measure_post_thickness(TilePool& pool, Progress& progress) {
+void Frame::measure_post_thickness(TilePool& pool, Progress& progress, bool assumed_in_plane) {
   constexpr int kPostBandRows = 64, kPostWidthPixels = 4;
-  constexpr float kDepthPerWidth = 2.0f / 3.0f;
+  const bool shaped = assumed_in_plane && shape_by_silhouettes_;
+  // Each pixel's rounded depth along its row (shaped only), for the columns' pass.
+  ScratchVector<float> across(shaped ? pixel_count() : 0);
   pool.for_each_row_band(width_, height_, kPostBandRows, progress, [&](const Tile& t) {
     for (int y = t.y0; y < t.y1; ++y) {
       const float* row = depth_.data() + index(0, y);
       float* out = last_thickness_.data() + index(0, y);
       std::fill_n(out, width_, 0.0f);
+      float* rounded = shaped ? across.data() + index(0, y) : nullptr;
+      if (shaped) std::fill_n(rounded, width_, 0.0f);
       const auto depth_at = [&](int x) { return row[x]; };
       for_each_run(width_, depth_at, [&](int x, int end, bool left, bool right) {
         const int before = left ? 0 : hidden_past(row, width_, x, end, -1);
@@ -320,6 +351,11 @@ void Frame::measure_post_thickness(TilePool& pool, Progress& progress) {
                               camera_.pixel_footprint(0.5f * (*nearest + *farthest));
           std::fill(out + x, out + end, kDepthPerWidth * std::max(width, *farthest - *nearest));
         }
+        if (shaped && (left || right)) {
+          rounded_depths(
+              x, end, left, right, [&](int i) { return camera_.pixel_footprint(row[i]); },
+              rounded + x);
+        }
         if (left) bound_by_side_face(x, y, -1, 0, end - x);
         if (right) bound_by_side_face(end - 1, y, 1, 0, end - x);
       });
@@ -327,14 +363,52 @@ void Frame::measure_post_thickness(TilePool& pool, Progress& progress) {
   });
   // Down the columns, bands of columns (the tile's rows are columns here).
   pool.for_each_row_band(height_, width_, kPostBandRows, progress, [&](const Tile& t) {
+    ScratchVector<float> down(shaped ? static_cast<size_t>(height_) : 0);
     for (int x = t.y0; x < t.y1; ++x) {
+      if (shaped) std::fill(down.begin(), down.end(), 0.0f);
       const auto depth_at = [&](int y) { return depth(x, y); };
       for_each_run(height_, depth_at, [&](int y, int end, bool top, bool bottom) {
+        if (shaped && (top || bottom)) {
+          rounded_depths(
+              y, end, top, bottom, [&](int i) { return camera_.pixel_footprint(depth(x, i)); },
+              down.data() + y);
+        }
         if (top) bound_by_side_face(x, y, 0, -1, end - y);
         if (bottom) bound_by_side_face(x, end - 1, 0, 1, end - y);
       });
+      if (!assumed_in_plane) continue;
+      for (int y = 0; y < height_; ++y) {
+        const float assumed =
+            shaped ? shaped_thickness(across[index(x, y)], down[size_t(y)]) : assumed_thickness_;
+        float& cell = last_thickness_[index(x, y)];
+        if (cell > 0.0f) {
+          cell = std::min(cell, assumed);
+        } else if (cell < 0.0f) {
+          if (!(-cell < assumed)) cell = assumed;  // the bound changes nothing
+        } else if (assumed != assumed_thickness_) {
+          cell = assumed;
+        }
+      }
     }
   });
+}
+
+// A rounded solid (a post, a sphere, a limb, a box seen at its corner) is deep where the view
+// crosses its middle and thin toward its silhouettes, where the view only grazes it; a constant
+// thickness darkened the surfaces just beyond a silhouette (halos) and left the middle of a big
+// solid too shallow to reach what stands behind it (docs/variants.md). A run with a drop at an end
+// is taken as such a solid's cross-section (rounded_depths): `across` along the pixel's row, `down`
+// its column (0: no drop). Where the row's depth is less than the assumed thickness it thins it,
+// down to kThinnestProfile times it; it thickens it, up to kThickestProfile times, only where the
+// column's is deeper too: a horizontal slab (a shelf, a bench's slat) is wide along its row but no
+// deeper than the furniture it belongs to, and its column tells nothing of that either (as the post
+// measure reads rows only).
+float Frame::shaped_thickness(float across, float down) const {
+  const float assumed = assumed_thickness_;
+  if (!(across > 0.0f)) return assumed;
+  if (across < assumed) return std::max(across, kThinnestProfile * assumed);
+  if (down > assumed) return std::min({across, down, kThickestProfile * assumed});
+  return assumed;
 }
 
 // A solid behind a face, as deep as t, has a side face from the face's edge t back along the
@@ -442,10 +516,10 @@ void Frame::bound_by_shown_side(int x, int y, int dx, int dy, int run, int first
 // distance (surfaces seen at an angle), and the match shows it as its visible surface with a
 // back face behind. The deepest of the four directions' matches counts, so that a thin
 // neighbour does not thin a thick solid.
-void Frame::infer_last_thickness(TilePool& pool, Progress& progress) {
+void Frame::infer_last_thickness(TilePool& pool, Progress& progress, bool assumed_in_plane) {
   last_thickness_.resize(pixel_count());
   if (extra_layers_ == 0) {
-    measure_post_thickness(pool, progress);
+    measure_post_thickness(pool, progress, assumed_in_plane && assumed_thickness_ > 0.0f);
     return;
   }
   pool.for_each_tile(width_, height_, progress, [&](const Tile& t) {
@@ -599,6 +673,8 @@ void normal_rotation(const FrameInputs& in, float rotation[9]) {
 }  // namespace
 
 void Frame::build(const FrameInputs& in, TilePool& pool, Progress& progress, unsigned extras) {
+  assumed_thickness_ = in.assumed_thickness;
+  shape_by_silhouettes_ = in.shape_thickness_by_silhouettes;
   fill_depth(in, pool, progress);
   build_normals(in, pool, progress);
   unmix_normals(pool, progress);
@@ -607,7 +683,7 @@ void Frame::build(const FrameInputs& in, TilePool& pool, Progress& progress, uns
 
 void Frame::derive_extras(unsigned extras, TilePool& pool, Progress& progress) {
   if ((extras & kSolidThickness) != 0) {
-    infer_last_thickness(pool, progress);
+    infer_last_thickness(pool, progress, (extras & kAssumedThickness) != 0);
   } else {
     std::vector<float>().swap(last_thickness_);
   }
@@ -938,6 +1014,8 @@ void Frame::downsample(const Frame& full, const FrameInputs& in, TilePool& pool,
                        unsigned extras) {
   reset(full.camera().coarser(2), (full.width() + 1) / 2, (full.height() + 1) / 2,
         full.extra_layers());
+  assumed_thickness_ = in.assumed_thickness;
+  shape_by_silhouettes_ = in.shape_thickness_by_silhouettes;
   normals_from_image_ = in.normal.attached();
   normal_.resize(pixel_count());
   mixed_normal_.resize(pixel_count());

@@ -36,6 +36,11 @@ struct FrameInputs {
   double camera_to_world[16] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
   // The background rule (ssao.h): a planar depth d is geometry when 0 < d < background_limit.
   float background_limit = 1e9f;
+  // Without extra layers, the depth assumed for the visible surfaces' solids (view units; 0:
+  // none), which kAssumedThickness folds into last_thickness_plane, shaped by the silhouettes
+  // where shape_thickness_by_silhouettes (Frame::shaped_thickness).
+  float assumed_thickness = 0.0f;
+  bool shape_thickness_by_silhouettes = false;
 };
 
 // background_limit from the parameters background_depth and clip_end (0: no clip).
@@ -47,7 +52,8 @@ enum FrameExtras : unsigned {
   kSolidThickness = 1u,      // last_thickness_plane
   kPlaneDistanceScale = 2u,  // plane_distance_scale_plane (with extra layers)
   kCarriedSurfaces = 4u,     // carried_depth_plane, carried_normal_plane (with one layer)
-  kAllFrameExtras = 7u,
+  kAssumedThickness = 8u,    // one layer: the assumed thickness folded into last_thickness_plane
+  kAllFrameExtras = 15u,
 };
 
 // Unit vector <-> 32 bits: octahedral mapping with 16 bits per coordinate (error < 1e-4 rad).
@@ -176,7 +182,11 @@ class Frame {
   // across its row (a post), a depth taken from its width (measure_post_thickness); stored
   // negated, how deep the face can be without showing the side face a deeper solid would
   // (bound_by_side_face), which holds for a receiver behind the face's tangent plane only (one
-  // in front reaches a point behind the face through it, whatever its depth).
+  // in front reaches a point behind the face through it, whatever its depth). With
+  // kAssumedThickness those are folded with the assumed thickness (FrameInputs), so that the
+  // plane holds the depth itself: the bound where less than the assumed thickness (a side-face
+  // bound stays negated), else the assumed thickness where it is not FrameInputs's (shaped), else
+  // 0.
   const float* last_thickness_plane() const {
     return last_thickness_.empty() ? nullptr : last_thickness_.data();
   }
@@ -191,6 +201,10 @@ class Frame {
     return dot(p - position(x, y), normal(x, y)) < 0.0f ? -t : 0.0f;
   }
   static constexpr int kThicknessSearch = 8;
+
+  // FrameInputs::assumed_thickness shaped by the silhouettes stays within these multiples of it
+  // (shaped_thickness).
+  static constexpr float kThinnestProfile = 0.5f, kThickestProfile = 1.5f;
 
   // With extra layers, per pixel: how far from the visible surface's tangent plane a point on
   // the pixel's ray lies per unit of planar depth it lies behind or in front of the surface
@@ -248,9 +262,13 @@ class Frame {
   // The extras (FrameExtras) from the finished depth, normal and layer planes; the planes of
   // the others are freed.
   void derive_extras(unsigned extras, TilePool& pool, Progress& progress);
-  // Fills last_thickness_ from the finished depth and layer planes.
-  void infer_last_thickness(TilePool& pool, Progress& progress);
-  void measure_post_thickness(TilePool& pool, Progress& progress);
+  // Fills last_thickness_ from the finished depth and layer planes; `assumed_in_plane`: with one
+  // layer, folds the assumed thickness in (kAssumedThickness).
+  void infer_last_thickness(TilePool& pool, Progress& progress, bool assumed_in_plane);
+  void measure_post_thickness(TilePool& pool, Progress& progress, bool assumed_in_plane);
+  // The assumed thickness at a pixel whose rounded depths along its row and column are `across`
+  // and `down` (0: no silhouette).
+  float shaped_thickness(float across, float down) const;
   // Where a run of pixels on one surface ends at (x, y), the surface dropping away to (x + dx,
   // y + dy): bounds the depth of its last face's solid (last_thickness_plane, negated).
   void bound_by_side_face(int x, int y, int dx, int dy, int run);
@@ -297,6 +315,8 @@ class Frame {
   bool normals_from_image_ = false;  // the normals came from a normal image, not the depth
   std::vector<float> layers_;
   std::vector<float> last_thickness_;
+  float assumed_thickness_ = 0.0f;     // FrameInputs::assumed_thickness
+  bool shape_by_silhouettes_ = false;  // FrameInputs::shape_thickness_by_silhouettes
   std::vector<float> plane_distance_scale_;
   std::vector<float> carried_depth_;
   std::vector<uint32_t> carried_normal_;

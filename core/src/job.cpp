@@ -529,6 +529,8 @@ void Job::run() {
   if (in.normal.attached() && in.world_normals) require_invertible_rotation(matrix);
   std::copy(matrix.begin(), matrix.end(), in.camera_to_world);
   in.background_limit = background_limit(v.get_float("background_depth"), v.get_float("clip_end"));
+  in.assumed_thickness = float(v.get_float("thickness")) * float(v.get_float("radius"));
+  in.shape_thickness_by_silhouettes = v.get_string("thickness_profile") == "silhouettes";
 
   progress.set_stage(0.0, 0.05);
   // The frame the variant sees: the input's, or a half-resolution copy (a quarter of the work;

@@ -100,6 +100,11 @@ const std::vector<Param>& params() {
           "show, where that is less); volumetric: a ray "
           "whose visible surface is this far in front of the sphere counts fully, fading out "
           "at twice the distance"),
+      string_param(kAo, "thickness_profile", "silhouettes", "silhouettes|constant",
+                   "hemisphere without extra layers: silhouettes: the assumed thickness is that "
+                   "of a rounded solid, thinner toward the silhouettes of the surface in front "
+                   "(down to half), thicker inside one as wide down its column as along its row "
+                   "(up to 1.5x); constant: the same everywhere"),
       string_param(kAo, "sphere_mode", "normalized", "normalized|classic",
                    "sphere variant: classic reads about 0.5 on a flat wall; normalized maps an "
                    "unoccluded flat surface to 1"),

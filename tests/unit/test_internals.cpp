@@ -593,6 +593,7 @@ TEST(Frame, EachVariantReadsOnlyTheExtrasItDeclares) {
         if ((info.frame_extras & ssao::kCarriedSurfaces) == 0) {
           EXPECT_EQ(f.carried_depth_plane(), nullptr) << info.name;
         }
+
         for (const bool reference : {false, true}) {
           const auto expected = estimate(all, reference, whole(all.frame));
           const auto got = estimate(declared, reference, whole(f));

@@ -649,7 +649,13 @@ TEST(Layers, FacingTellsAnOpenSurfaceFromASolid) {
   const auto ao = [&](bool layers, bool facing) {
     return layered_ao(s, cam, layers, facing, "full", "hemisphere", 6);
   };
-  const Stats one = stats_over(s, ao(false, true), wall_beside_card);
+  // One layer with the thickness the layered reading assumes: the same everywhere.
+  const std::vector<float> flat = compute_ao(s, cam, kRadius, "hemisphere", true, [&](Job& j) {
+    j.set("resolution", "full");
+    j.set("steps", 6);
+    j.set("thickness_profile", "constant");
+  });
+  const Stats one = stats_over(s, flat, wall_beside_card);
   const Stats faced = stats_over(s, ao(true, true), wall_beside_card);
   const Stats alternating = stats_over(s, ao(true, false), wall_beside_card);
   std::printf(
@@ -661,6 +667,42 @@ TEST(Layers, FacingTellsAnOpenSurfaceFromASolid) {
   // the gap up to the wall would be the inside of a solid.
   EXPECT_NEAR(faced.mean, one.mean, 0.002);
   EXPECT_LT(alternating.mean, one.mean - 0.02);
+}
+
+TEST(Layers, OneLayerShapesTheThicknessByTheSilhouettes) {
+  // A ball before a wall, one layer, the wall around it against ray-traced AO. A small ball
+  // standing off the wall: beyond its rim the view only grazes it, and a constant thickness
+  // drew a halo on the wall there. A big ball almost touching the wall: its middle, deeper than
+  // the assumed thickness, reaches the wall beside it.
+  struct Case {
+    double ball, gap;
+  };
+  for (const Case c : {Case{0.3, 0.3}, Case{1.0, 0.05}}) {
+    Camera cam;
+    cam.width = 160, cam.height = 120;
+    const V3 centre{0.0, 0.0, -6.0 + c.gap + c.ball};
+    const std::vector<Solid> solids = {{{{0, 0, -6}, {0, 0, 1}}},
+                                       polyhedral_sphere(centre, c.ball)};
+    Scene s = ray_cast(cam, solids);
+    const Scored around = score_where(s, solids, 256, 4, 4, 1, [&](const V3& p) {
+      return p.z < -5.99 && std::hypot(p.x - centre.x, p.y - centre.y) < c.ball + kRadius;
+    });
+    ASSERT_GT(around.pixels.size(), 1000u);
+    const auto one_layer = [&](const char* profile) {
+      return error_against(compute_ao(s, cam, kRadius, "hemisphere", true,
+                                      [&](Job& j) {
+                                        j.set("resolution", "full");
+                                        j.set("thickness_profile", profile);
+                                      }),
+                           around.reference, around.pixels);
+    };
+    const Error shaped = one_layer("silhouettes"), flat = one_layer("constant");
+    std::printf(
+        "[ measure  ] wall around a ball of radius %.1f, %.2f off it, %zu px: one layer RMSE "
+        "%.4f bias %+.4f (constant thickness: %.4f, %+.4f)\n",
+        c.ball, c.gap, around.pixels.size(), shaped.rmse, shaped.bias, flat.rmse, flat.bias);
+    EXPECT_LT(shaped.rmse, 0.9 * flat.rmse) << c.ball;
+  }
 }
 
 TEST(Layers, ACardIsReadTheSameFromEitherSideWhenHandedOnAsATwin) {

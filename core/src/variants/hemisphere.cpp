@@ -264,25 +264,22 @@ HWY_INLINE VF between_lanes(const HemisphereRowArgs& a, const LaneProjection<VF>
 }
 
 // Without extra layers: 1 / the depth of the visible surface's solid at pixel `index` (point q)
-// for the receiver p, the assumed thickness or, where the frame bounds it there, the bound if
-// less (Frame::last_thickness_seen_from: a side-face bound, stored negated, for a receiver
-// behind the face's tangent plane only). Read on the lanes `needed` only, those whose point lies
-// behind the surface: in front of it the thickness weight is 1 whatever the depth.
+// for the receiver p: the frame's (Frame::last_thickness_seen_from, with kAssumedThickness: the
+// assumed thickness as the silhouettes shape it, or a bound where less; a side-face bound, stored
+// negated, holds for a receiver behind the face's tangent plane only), else the assumed one. Read
+// on the lanes `needed` only, those whose point lies behind the surface: in front of it the
+// thickness weight is 1 whatever the depth.
 template <class M, class VF, class VI>
 HWY_INLINE VF inv_visible_thickness_lanes(const HemisphereRowArgs& a, M needed, VI index, VF px,
                                           VF py, VF pz, VF qx, VF qy, VF qz) {
   namespace hn = hwy::HWY_NAMESPACE;
   const hn::DFromV<VF> df;
   const hn::RebindToSigned<decltype(df)> di;
-  if (a.last_thickness == nullptr || hn::AllFalse(df, needed)) {
-    return hn::Set(df, 1.0f / a.thickness);
-  }
+  const VF inv_assumed = hn::Set(df, 1.0f / a.thickness);
+  if (a.last_thickness == nullptr || hn::AllFalse(df, needed)) return inv_assumed;
   const VF signed_measure = hn::GatherIndex(df, a.last_thickness, index);
-  const VF measured = hn::Abs(signed_measure);
   auto known = hn::Gt(signed_measure, hn::Zero(df));
-  // A bound no less than the assumed thickness changes nothing: no normal to read for it.
-  const auto sided = hn::And(needed, hn::And(hn::Lt(signed_measure, hn::Zero(df)),
-                                             hn::Gt(signed_measure, hn::Set(df, -a.thickness))));
+  const auto sided = hn::And(needed, hn::Lt(signed_measure, hn::Zero(df)));
   if (!hn::AllFalse(df, sided)) {
     VF nx, ny, nz;
     decode_directions(df, hn::GatherIndex(di, reinterpret_cast<const int32_t*>(a.normals), index),
@@ -290,9 +287,9 @@ HWY_INLINE VF inv_visible_thickness_lanes(const HemisphereRowArgs& a, M needed, 
     const VF side = hn::MulAdd(px - qx, nx, hn::MulAdd(py - qy, ny, (pz - qz) * nz));
     known = hn::Or(known, hn::And(sided, hn::Lt(side, hn::Zero(df))));
   }
-  return hn::Max(hn::Set(df, 1.0f / a.thickness),
-                 hn::IfThenElseZero(known, hn::Set(df, 1.0f) /
-                                               hn::IfThenElse(known, measured, hn::Set(df, 1.0f))));
+  return hn::IfThenElse(
+      known, hn::Set(df, 1.0f) / hn::IfThenElse(known, hn::Abs(signed_measure), hn::Set(df, 1.0f)),
+      inv_assumed);
 }
 
 // Frame::solid_entry on the lanes of `hidden`, points at planar depth `depth` behind the visible
@@ -1093,11 +1090,8 @@ class Hemisphere final : public Variant {
     entry = f.solid_entry(qx, qy, depth, closed, &past_last);
     if (entry == Frame::kBackground) return 0.0f;
     const float measured = past_last ? f.last_thickness_seen_from(qx, qy, p) : 0.0f;
-    // Without extra layers the measure is a bound (a post's width, the side face a deeper solid
-    // would show), taken where it is the less.
-    const float depth_of_solid =
-        !(measured > 0.0f) ? thickness_
-                           : (f.extra_layers() > 0 ? measured : std::min(measured, thickness_));
+    // Without extra layers the frame folded the assumed thickness in (kAssumedThickness).
+    const float depth_of_solid = measured > 0.0f ? measured : thickness_;
     return closed ? 1.0f : thickness_weight(depth - entry, depth_of_solid);
   }
 
@@ -1241,11 +1235,11 @@ const VariantInfo kHemisphereVariant = {
     "hemisphere",
     "normal-oriented hemisphere kernel: directions cosine-weighted about the normal, each "
     "marched in steps",
-    "samples|steps|sample_clustering|thickness|bias|seed",
+    "samples|steps|sample_clustering|thickness|thickness_profile|bias|seed",
     [](const ParamValues& v, const Frame& f) -> std::unique_ptr<Variant> {
       return std::make_unique<Hemisphere>(v, f);
     },
-    kSolidThickness | kPlaneDistanceScale | kCarriedSurfaces};
+    kSolidThickness | kPlaneDistanceScale | kCarriedSurfaces | kAssumedThickness};
 
 }  // namespace ssao
 #endif  // HWY_ONCE
