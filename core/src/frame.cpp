@@ -287,8 +287,8 @@ constexpr float kDepthPerWidth = 2.0f / 3.0f;
 // run's drops to a farther surface (a silhouette) before and after it, into out[i - begin] (view
 // units, times kDepthPerWidth; `footprint_at(i)`: pixel i's width in view units). A circle's
 // chord: 2 sqrt(a b) pixels for a pixel a from one drop and b from the other; with one drop (the
-// run may go on behind a nearer surface at its other end), as if the run were the radius,
-// 2 sqrt(a w) for a run w long. Not called without a drop.
+// run may go on behind a nearer surface at its other end), 2 sqrt(a w) for a run w long: near
+// the drop, the chord of a circle as wide as the run. Not called without a drop.
 template <class FootprintAt>
 void rounded_depths(int begin, int end, bool drop_before, bool drop_after, FootprintAt footprint_at,
                     float* out) {
@@ -370,7 +370,8 @@ void Frame::measure_post_thickness(TilePool& pool, Progress& progress, bool assu
       for_each_run(height_, depth_at, [&](int y, int end, bool top, bool bottom) {
         if (shaped && (top || bottom)) {
           rounded_depths(
-              y, end, top, bottom, [&](int i) { return camera_.pixel_footprint(depth(x, i)); },
+              y, end, top, bottom,
+              [&](int i) { return camera_.pixel_footprint(depth(x, i)) * camera_.pixel_aspect(); },
               down.data() + y);
         }
         if (top) bound_by_side_face(x, y, 0, -1, end - y);
@@ -384,7 +385,9 @@ void Frame::measure_post_thickness(TilePool& pool, Progress& progress, bool assu
         if (cell > 0.0f) {
           cell = std::min(cell, assumed);
         } else if (cell < 0.0f) {
-          if (!(-cell < assumed)) cell = assumed;  // the bound changes nothing
+          // A side-face bound less than the assumed depth stays (a receiver in front of the face
+          // then takes the unshaped assumed thickness); else it changes nothing.
+          if (!(-cell < assumed)) cell = assumed;
         } else if (assumed != assumed_thickness_) {
           cell = assumed;
         }

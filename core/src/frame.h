@@ -178,15 +178,15 @@ class Frame {
   // hidden behind the visible surface and no later hit closes it (a column behind a fence post
   // whose back would be hit 4), as measured where a neighbour within kThicknessSearch pixels
   // sees a surface at that depth with its back face. Without them the last hit is the visible
-  // surface, and the plane holds upper bounds on the assumed thickness: on something narrow
+  // surface, and the plane holds bounds on the assumed thickness: on something narrow
   // across its row (a post), a depth taken from its width (measure_post_thickness); stored
   // negated, how deep the face can be without showing the side face a deeper solid would
   // (bound_by_side_face), which holds for a receiver behind the face's tangent plane only (one
   // in front reaches a point behind the face through it, whatever its depth). With
-  // kAssumedThickness those are folded with the assumed thickness (FrameInputs), so that the
-  // plane holds the depth itself: the bound where less than the assumed thickness (a side-face
-  // bound stays negated), else the assumed thickness where it is not FrameInputs's (shaped), else
-  // 0.
+  // kAssumedThickness those are folded with the assumed thickness (FrameInputs, shaped by the
+  // silhouettes where asked), so that the plane holds the depth itself: a bound where less than
+  // the assumed depth (a side-face bound stays negated; a receiver in front of its face takes
+  // FrameInputs's thickness), else the assumed depth where it is not FrameInputs's, else 0.
   const float* last_thickness_plane() const {
     return last_thickness_.empty() ? nullptr : last_thickness_.data();
   }

@@ -96,8 +96,9 @@ const std::vector<Param>& params() {
           "assumed thickness of surfaces: horizon: an occluder spans this far behind the visible "
           "surface; hemisphere: a sample this far behind the visible surface counts fully, "
           "fading out at twice the distance (range check against halos; without extra layers "
-          "a post's depth taken from its width, or a face's from the side a deeper solid would "
-          "show, where that is less); volumetric: a ray "
+          "shaped as thickness_profile says, and a post's depth taken from its width, or a "
+          "face's from the side a deeper solid would show, where that is less); volumetric: a "
+          "ray "
           "whose visible surface is this far in front of the sphere counts fully, fading out "
           "at twice the distance"),
       string_param(kAo, "thickness_profile", "silhouettes", "silhouettes|constant",

@@ -403,6 +403,8 @@ class AddonTest(unittest.TestCase):
         # 0.0542, 0.0333. With the surfaces at the frame's border carried on beyond it
         # (2026-12-05, docs/variants.md): 0.0541, 0.0336, 0.0541, 0.0333: beyond this frame are
         # the floor and the wall, which their planes at the border give as well as the band.
+        # With one layer's thickness shaped by the silhouettes (2026-12-07, docs/variants.md
+        # hemisphere item 15), 3.4: 0.0418, 0.0336, 0.0418, 0.0332: the layers' gain is a fifth.
         # What only a band shows is tested in tests/unit/test_overscan.cpp and by the POV-Ray
         # bridge's edge occluders.
         rmse = {}
@@ -417,10 +419,10 @@ class AddonTest(unittest.TestCase):
                 (ao[geometry] - passes["AO.R"][geometry]) ** 2)))
             print(f"\n[measure] node AO vs Cycles AO pass, hidden_surfaces={hidden} "
                   f"overscan={overscan}: RMSE {rmse[hidden, overscan]:.4f}", file=sys.stderr)
-        self.assertLess(rmse["PEELED", 0], rmse["NONE", 0] - 0.01)
+        self.assertLess(rmse["PEELED", 0], 0.9 * rmse["NONE", 0])
         self.assertLess(rmse["NONE", 16], rmse["NONE", 0] + 0.002)
         self.assertLess(rmse["PEELED", 16], rmse["PEELED", 0] + 0.002)
-        self.assertLess(rmse["PEELED", 16], rmse["NONE", 16] - 0.01)
+        self.assertLess(rmse["PEELED", 16], 0.9 * rmse["NONE", 16])
 
     def test_hidden_surfaces_read_cutouts_and_cards(self):
         # Open surfaces with alpha cut-outs (a lattice fence, leaf cards facing either way, a

@@ -362,6 +362,10 @@ void prepare(PreparedFrame& out, const Camera& cam, const char* variant, bool la
     }
   }
   in.extra_layers = layers ? 2 : 0;
+  // As Job::run: the assumed thickness shaped by the silhouettes (one layer, kAssumedThickness).
+  in.assumed_thickness =
+      float(out.values.get_float("thickness")) * float(out.values.get_float("radius"));
+  in.shape_thickness_by_silhouettes = true;
   ssao::TilePool pool(2);
   ssao::Progress progress(nullptr, nullptr);
   out.frame.reset(camera_model(c, s.width, s.height), s.width, s.height, in.extra_layers);
@@ -593,7 +597,6 @@ TEST(Frame, EachVariantReadsOnlyTheExtrasItDeclares) {
         if ((info.frame_extras & ssao::kCarriedSurfaces) == 0) {
           EXPECT_EQ(f.carried_depth_plane(), nullptr) << info.name;
         }
-
         for (const bool reference : {false, true}) {
           const auto expected = estimate(all, reference, whole(all.frame));
           const auto got = estimate(declared, reference, whole(f));
