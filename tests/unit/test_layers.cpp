@@ -646,8 +646,8 @@ TEST(Layers, FacingTellsAnOpenSurfaceFromASolid) {
   };
   // The same steps with and without layers (their presets differ), so that only the reading of
   // the hits differs.
-  const auto ao = [&](bool layers, bool facing) {
-    return layered_ao(s, cam, layers, facing, "full", "hemisphere", 6);
+  const auto layered = [&](bool facing) {
+    return layered_ao(s, cam, true, facing, "full", "hemisphere", 6);
   };
   // One layer with the thickness the layered reading assumes: the same everywhere.
   const std::vector<float> flat = compute_ao(s, cam, kRadius, "hemisphere", true, [&](Job& j) {
@@ -656,8 +656,8 @@ TEST(Layers, FacingTellsAnOpenSurfaceFromASolid) {
     j.set("thickness_profile", "constant");
   });
   const Stats one = stats_over(s, flat, wall_beside_card);
-  const Stats faced = stats_over(s, ao(true, true), wall_beside_card);
-  const Stats alternating = stats_over(s, ao(true, false), wall_beside_card);
+  const Stats faced = stats_over(s, layered(true), wall_beside_card);
+  const Stats alternating = stats_over(s, layered(false), wall_beside_card);
   std::printf(
       "[ measure  ] open card: wall beside it: one layer %.5f, facing given %.5f, "
       "alternating %.5f\n",
