@@ -269,6 +269,18 @@ class Frame {
   // The assumed thickness at a pixel whose rounded depths along its row and column are `across`
   // and `down` (0: no silhouette).
   float shaped_thickness(float across, float down) const;
+  // Whether, of pixel (x, y) and its neighbour (x + dx, y + dy), the nearer passes in front of
+  // the farther by what the normals and the depths beyond tell, where the depth step alone is too
+  // small to end a run (see frame.cpp). Called for every pair of neighbours a run joins: the
+  // common case, a step of less than the margin, is answered inline.
+  bool passes_in_front(int x, int y, int dx, int dy) const {
+    const float a = depth(x, y), b = depth(x + dx, y + dy);
+    return std::fabs(a - b) > kPartedFootprints * camera_.pixel_footprint(std::min(a, b)) &&
+           parted_by_normals(x, y, dx, dy);
+  }
+  bool parted_by_normals(int x, int y, int dx, int dy) const;
+  // passes_in_front's margins: in pixel footprints, and over the two points' distance.
+  static constexpr float kPartedFootprints = 1.0f, kPartedSlope = 0.1f;
   // Where a run of pixels on one surface ends at (x, y), the surface dropping away to (x + dx,
   // y + dy): bounds the depth of its last face's solid (last_thickness_plane, negated).
   void bound_by_side_face(int x, int y, int dx, int dy, int run);
