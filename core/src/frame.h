@@ -128,6 +128,10 @@ class Frame {
   const float* depth_plane() const { return depth_.data(); }
   float depth(int x, int y) const { return depth_[index(x, y)]; }
   bool is_geometry(int x, int y) const { return depth_[index(x, y)] != kBackground; }
+  // Inside the frame and geometry.
+  bool geometry_at(int x, int y) const {
+    return x >= 0 && y >= 0 && x < width_ && y < height_ && is_geometry(x, y);
+  }
   Vec3 position(int x, int y) const {
     return camera_.view_position(float(x) + 0.5f, float(y) + 0.5f, depth(x, y));
   }

@@ -77,6 +77,10 @@ inline void orthonormal_basis(Vec3 n, Vec3& t, Vec3& b) {
   b = {c, sign + n.y * n.y * a, -n.y};
 }
 
+// n or -n, whichever has a non-negative component along `towards` (a face's normal turned to
+// the camera, a plane's to a surface's side).
+inline Vec3 turned_towards(Vec3 n, Vec3 towards) { return dot(n, towards) < 0.0f ? n * -1.0f : n; }
+
 inline float saturate(float v) { return v < 0.0f ? 0.0f : (v > 1.0f ? 1.0f : v); }
 
 }  // namespace ssao
