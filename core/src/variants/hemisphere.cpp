@@ -56,6 +56,10 @@ struct HemisphereRowArgs {
 // A surface the crossing test finds at the crossing point, up to its tolerance behind the crossed
 // plane, is that plane's own surface when its normal lies within 60 degrees of the plane's.
 constexpr float kSamePlaneCos = 0.5f;
+// Hemisphere::between: a solid at the halfway point's pixel thinner along the ray than this many
+// times the distance between the two steps may lie anywhere between them (the crossing test).
+// At 1 x the kit's 6 scenes lost 0.0008 of RMSE on `thin` against 2 x, the rest within 0.0003.
+constexpr float kThinSolidSegments = 2.0f;
 }  // namespace ssao
 #endif
 
@@ -214,20 +218,24 @@ HWY_INLINE VF reach_lanes(const HemisphereRowArgs& a, const LaneProjection<VF>& 
   return hn::IfThenElseZero(on_surface, hn::Min(one, part));
 }
 
-// Hemisphere::between on the lanes of `candidate`: point (mx, my, mz), halfway between two
-// steps of a direction, lies behind the visible surface of its pixel and in front of the ray's
-// next hit, and that surface is above the receiver's tangent plane (normal n, level
-// `plane_level`): the part of the point's cone behind it or, if more, of the cone at the
-// direction's end (ex, ey, ez) past its tangent plane, times the solid's weight (1 where the
-// next hit is a back face, else by the assumed thickness).
+// Hemisphere::between on the lanes of `candidate`: the point halfway between two steps of a
+// direction, (ax, ay, az) and (bx, by, bz), where the visible surface of its pixel is above the
+// receiver's tangent plane (normal g, level `plane_level`): where the point lies behind that
+// surface and in front of the ray's next hit, the part of its cone behind it or, if more, of the
+// cone at the direction's end (ex, ey, ez) past its tangent plane, times the solid's weight (1
+// where the next hit is a back face, else by the assumed thickness); where the ray's hits make a
+// solid thinner along the ray than kThinSolidSegments x the segment, the crossing test with the
+// surface's plane (`extend`: the direction's length beyond b over b - a).
 template <class M, class VF>
 HWY_INLINE VF between_lanes(const HemisphereRowArgs& a, const LaneProjection<VF>& project,
-                            M candidate, VF mx, VF my, VF mz, VF ex, VF ey, VF ez, VF nx, VF ny,
-                            VF nz, VF plane_level, VF half_inv_width) {
+                            M candidate, VF ax, VF ay, VF az, VF bx, VF by, VF bz, VF ex, VF ey,
+                            VF ez, VF gx, VF gy, VF gz, VF plane_level, VF half_inv_width,
+                            VF extend) {
   namespace hn = hwy::HWY_NAMESPACE;
   const hn::DFromV<VF> df;
   const hn::RebindToSigned<decltype(df)> di;
-  const VF zero = hn::Zero(df), one = hn::Set(df, 1.0f);
+  const VF zero = hn::Zero(df), one = hn::Set(df, 1.0f), half = hn::Set(df, 0.5f);
+  const VF mx = (ax + bx) * half, my = (ay + by) * half, mz = (az + bz) * half;
   VF mu, mv;
   const auto lanes = hn::And(candidate, project(mx, my, mz, mu, mv));
   if (hn::AllFalse(df, lanes)) return zero;
@@ -235,32 +243,45 @@ HWY_INLINE VF between_lanes(const HemisphereRowArgs& a, const LaneProjection<VF>
   const auto qy = hn::ConvertTo(di, hn::IfThenElseZero(lanes, mv));
   const auto index = qy * hn::Set(di, a.width) + qx;
   const VF qd = hn::GatherIndex(df, a.depth, index);
-  const VF behind = hn::Neg(mz) - qd;  // > 0: the visible surface is in front of the point
   VF ray_x, ray_y;
   project.pixel_ray(qx, qy, ray_x, ray_y);
   const VF q_scale = a.camera.orthographic ? one : qd;
-  const auto hidden = hn::And(
-      hn::And(lanes, hn::Lt(qd, hn::Set(df, std::numeric_limits<float>::infinity()))),
-      hn::And(
-          hn::Gt(behind, zero),
-          hn::Gt(hn::MulAdd(ray_x * q_scale, nx, hn::MulAdd(ray_y * q_scale, ny, hn::Neg(qd) * nz)),
-                 plane_level)));
-  if (hn::AllFalse(df, hidden)) return zero;
+  const VF qxv = ray_x * q_scale, qyv = ray_y * q_scale, qzv = hn::Neg(qd);
+  const auto above =
+      hn::And(hn::And(lanes, hn::Lt(qd, hn::Set(df, std::numeric_limits<float>::infinity()))),
+              hn::Gt(hn::MulAdd(qxv, gx, hn::MulAdd(qyv, gy, qzv * gz)), plane_level));
+  if (hn::AllFalse(df, above)) return zero;
   const VF next = hn::GatherIndex(df, a.layers, index);
-  const auto inside = hn::And(hidden, hn::Le(hn::Neg(mz), hn::Abs(next)));
-  if (hn::AllFalse(df, inside)) return zero;
-  const VF scale = hn::GatherIndex(df, a.plane_distance_scale, index);
+  const VF behind = hn::Neg(mz) - qd;  // > 0: the visible surface is in front of the point
+  const auto inside =
+      hn::And(hn::And(above, hn::Gt(behind, zero)), hn::Le(hn::Neg(mz), hn::Abs(next)));
+  const VF bax = bx - ax, bay = by - ay, baz = bz - az;
+  const VF segment = hn::Sqrt(hn::MulAdd(bax, bax, hn::MulAdd(bay, bay, baz * baz)));
+  const auto thin =
+      hn::And(above, hn::Lt(hn::Abs(next) - qd, hn::Set(df, kThinSolidSegments) * segment));
+  if (hn::AllFalse(df, hn::Or(inside, thin))) return zero;
   VF cx, cy, cz;
   decode_directions(df, hn::GatherIndex(di, reinterpret_cast<const int32_t*>(a.normals), index), cx,
                     cy, cz);
-  const VF qxv = ray_x * q_scale, qyv = ray_y * q_scale, qzv = hn::Neg(qd);
-  const VF side_e = hn::MulAdd(ex - qxv, cx, hn::MulAdd(ey - qyv, cy, (ez - qzv) * cz));
-  const VF past_end = hn::Neg(side_e) / hn::Sqrt(hn::MulAdd(cx, cx, hn::MulAdd(cy, cy, cz * cz)));
-  const VF covered =
-      hn::Min(one, hn::Max(zero, hn::Max(cone_part_lanes(behind * scale, half_inv_width),
-                                         end_part_lanes(a, past_end))));
-  const VF thick = thickness_weight_lanes(behind, hn::Set(df, 1.0f / a.thickness));
-  return hn::IfThenElseZero(inside, covered * hn::IfThenElse(hn::Lt(next, zero), one, thick));
+  VF weight = zero;
+  if (!hn::AllFalse(df, inside)) {
+    const VF scale = hn::GatherIndex(df, a.plane_distance_scale, index);
+    const VF side_e = hn::MulAdd(ex - qxv, cx, hn::MulAdd(ey - qyv, cy, (ez - qzv) * cz));
+    const VF past_end = hn::Neg(side_e) / hn::Sqrt(hn::MulAdd(cx, cx, hn::MulAdd(cy, cy, cz * cz)));
+    const VF covered =
+        hn::Min(one, hn::Max(zero, hn::Max(cone_part_lanes(behind * scale, half_inv_width),
+                                           end_part_lanes(a, past_end))));
+    const VF thick = thickness_weight_lanes(behind, hn::Set(df, 1.0f / a.thickness));
+    weight = hn::IfThenElseZero(inside, covered * hn::IfThenElse(hn::Lt(next, zero), one, thick));
+  }
+  // The crossing test where a and b lie on either side of the thin solid's plane.
+  const VF w = hn::MulAdd(qxv, cx, hn::MulAdd(qyv, cy, qzv * cz));
+  const auto crosses = hn::And(hn::And(thin, hn::Lt(weight, one)),
+                               hn::Xor(hn::Gt(hn::MulAdd(ax, cx, hn::MulAdd(ay, cy, az * cz)), w),
+                                       hn::Gt(hn::MulAdd(bx, cx, hn::MulAdd(by, cy, bz * cz)), w)));
+  if (hn::AllFalse(df, crosses)) return weight;
+  return hn::Max(
+      weight, crossing_lanes(a, project, crosses, ax, ay, az, bx, by, bz, cx, cy, cz, w, extend));
 }
 
 // Without extra layers: 1 / the depth of the visible surface's solid at pixel `index` (point q)
@@ -671,10 +692,9 @@ HWY_NOINLINE void hemisphere_row_of(const HemisphereRowArgs& a, int y, int x0, i
           // Halfway from the previous point (Hemisphere::between).
           const auto open_lanes = hn::And(receiver, hn::Lt(blocked, one));
           if (!hn::AllFalse(df, open_lanes)) {
-            blocked = hn::Max(
-                blocked, between_lanes(a, project, open_lanes, (ax + sx) * half, (ay + sy) * half,
-                                       (az + sz) * half, end_x, end_y, end_z, gx, gy, gz,
-                                       plane_level, half_inv_width_between));
+            blocked = hn::Max(blocked, between_lanes(a, project, open_lanes, ax, ay, az, sx, sy, sz,
+                                                     end_x, end_y, end_z, gx, gy, gz, plane_level,
+                                                     half_inv_width_between, extend));
           }
           auto hidden = none;
           auto above = none;  // the visible surface lies above the tangent plane: it may occlude
@@ -949,8 +969,7 @@ class Hemisphere final : public Variant {
         const Vec3 end = layered ? sample + (sample - previous) * cone->extend : Vec3{};
         if (layered && blocked < 1.0f) {
           blocked = std::max(
-              blocked, between(f, p, geometric_normal, min_height, (previous + sample) * 0.5f, end,
-                               cone->half_inv_width_between));
+              blocked, between(f, p, geometric_normal, min_height, previous, sample, end, *cone));
         }
         int qx = -1, qy = -1;
         bool hidden = false, above = false;
@@ -1119,31 +1138,45 @@ class Hemisphere final : public Variant {
   // width short of it. Not clamped.
   float end_part(float past) const { return past * half_inv_end_width_ + 0.5f; }
 
-  // A point halfway between two steps of a direction (a 2 cm board seen edge-on is a pixel or
-  // two wide on screen and falls between steps that lie several pixels apart): when it lies
-  // behind the visible surface of its pixel, in front of the ray's next hit, and that surface is
-  // above the receiver's tangent plane (p, normal, min_height), the part of the point's cone
-  // (0.5 / its width: half_inv_width) behind the surface or, if more, of the cone at the
-  // direction's end past the surface's tangent plane, times the solid's weight: 1 when the next
-  // hit is a back face that closes it, else by the assumed thickness. Cheaper than a step: no
-  // deeper hits, no crossing test.
-  float between(const Frame& f, Vec3 p, Vec3 normal, float min_height, Vec3 point, Vec3 end,
-                float half_inv_width) const {
+  // A point halfway between two steps of a direction, `previous` and `sample` (a 2 cm board seen
+  // edge-on is a pixel or two wide on screen and falls between steps that lie several pixels
+  // apart), where the visible surface of its pixel is above the receiver's tangent plane (p,
+  // normal, min_height):
+  // - when it lies behind that surface and in front of the ray's next hit, the part of the
+  //   point's cone (0.5 / its width: half_inv_width) behind the surface or, if more, of the cone
+  //   at the direction's end past the surface's tangent plane, times the solid's weight: 1 when
+  //   the next hit is a back face that closes it, else by the assumed thickness;
+  // - when the ray's hits there make a solid thinner along the ray than kThinSolidSegments x the
+  //   segment, the segment may pass through it anywhere, not at its midpoint only: the crossing
+  //   test with the surface's plane (a board beside the midpoint, both points in free space in
+  //   front of what their pixels show, is seen by neither).
+  // Cheaper than a step: no deeper hits.
+  float between(const Frame& f, Vec3 p, Vec3 normal, float min_height, Vec3 previous, Vec3 sample,
+                Vec3 end, const Cone& cone) const {
+    const Vec3 point = (previous + sample) * 0.5f;
     int qx, qy;
     if (!pixel_of_sample(f, point, qx, qy) || !f.is_geometry(qx, qy)) return 0.0f;
-    const float behind = -point.z - f.depth(qx, qy);
     const Vec3 q = f.position(qx, qy);
-    if (!(behind > 0.0f) || !(dot(q - p, normal) > min_height)) return 0.0f;
+    if (!(dot(q - p, normal) > min_height)) return 0.0f;
+    const float depth = f.depth(qx, qy);
+    const float behind = -point.z - depth;
     const float next = f.layer_planes()[f.index(qx, qy)];  // the ray's 2nd hit
-    if (!(-point.z <= std::fabs(next))) return 0.0f;
-    const float weight = next < 0.0f ? 1.0f : thickness_weight(behind, thickness_);
-    // The direction goes on to `end`: the part of its cone there past the surface's tangent
-    // plane, if more (a board the direction pierces blocks the whole cone, however thin).
     const Vec3 nq = f.normal(qx, qy);
-    const float past_end = -dot(end - q, nq) / length(nq);
-    return saturate(std::max(behind * f.plane_distance_scale(qx, qy) * half_inv_width + 0.5f,
-                             end_part(past_end))) *
-           weight;
+    float weight = 0.0f;
+    if (behind > 0.0f && -point.z <= std::fabs(next)) {
+      const float solid = next < 0.0f ? 1.0f : thickness_weight(behind, thickness_);
+      // The direction goes on to `end`: the part of its cone there past the surface's tangent
+      // plane, if more (a board the direction pierces blocks the whole cone, however thin).
+      const float past_end = -dot(end - q, nq) / length(nq);
+      weight = saturate(std::max(
+                   behind * f.plane_distance_scale(qx, qy) * cone.half_inv_width_between + 0.5f,
+                   end_part(past_end))) *
+               solid;
+    }
+    if (weight < 1.0f && std::fabs(next) - depth < kThinSolidSegments * length(sample - previous)) {
+      weight = std::max(weight, crossing(f, previous, sample, q, nq, cone.extend));
+    }
+    return weight;
   }
 
   // One layer: the point halfway between the receiver and its first step, when that step lies in
