@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <functional>
 #include <limits>
 #include <string>
 
@@ -593,26 +594,45 @@ TEST(Layers, ThinBoardOverAWallIsNoLighterWithLayers) {
   EXPECT_LT(std::fabs(one.bias), 0.02);
 }
 
+// A 2 cm board standing `depth` out of a wall at z = -4, from x = board_x to board_x + 0.02, seen
+// by a 256 x 192 camera at the origin: one layer's and 3 hits' error (and the ray-traced mean, 512
+// rays) over the wall pixels near the centre rows for which `scored_wall` holds.
+struct BoardOnAWall {
+  Error one, three;
+  double mean_reference = 0;
+};
+
+BoardOnAWall board_on_a_wall(double board_x, double depth,
+                             const std::function<bool(const V3&)>& scored_wall) {
+  Camera cam;
+  cam.width = 256, cam.height = 192;
+  const double wall_z = -4.0, thickness = 0.02;
+  const std::vector<Solid> solids = {
+      {{{0, 0, wall_z}, {0, 0, 1}}},
+      box({board_x, -10, wall_z - 0.5}, {board_x + thickness, 10, wall_z + depth})};
+  Scene s = ray_cast(cam, solids);
+  const Scored scored = score_where(s, solids, 512, 8, 80, 2, [&](const V3& p) {
+    return std::fabs(p.z - wall_z) < 1e-6 && scored_wall(p);
+  });
+  EXPECT_GT(scored.pixels.size(), 300u);
+  BoardOnAWall result;
+  result.one = error_against(layered_ao(s, cam, false), scored.reference, scored.pixels);
+  result.three = error_against(layered_ao(s, cam, true), scored.reference, scored.pixels);
+  result.mean_reference = scored.mean_reference();
+  return result;
+}
+
 TEST(Layers, ABoardSeenEdgeOnDarkensTheWallBesideIt) {
   // A 2 cm board standing out of a wall, 1 deep, seen nearly edge-on (a bookcase's side panel
   // from in front): 2 px wide on screen, where the steps of a direction lie about 5 px apart.
   // With layers a step beyond the board is free space, so the wall beside it reads light unless
   // a test between the steps lands on the board (Hemisphere::between).
-  Camera cam;
-  cam.width = 256, cam.height = 192;
-  const double wall_z = -4.0, board_x = 0.1, thickness = 0.02;
-  const std::vector<Solid> solids = {
-      {{{0, 0, wall_z}, {0, 0, 1}}},
-      box({board_x, -10, wall_z - 0.5}, {board_x + thickness, 10, wall_z + 1.0})};
-  Scene s = ray_cast(cam, solids);
-  // The wall within 0.5 of the board on either side, the rows near the centre; 512 rays.
-  const Scored scored = score_where(s, solids, 512, 8, 80, 2, [&](const V3& p) {
-    return std::fabs(p.z - wall_z) < 1e-6 && std::fabs(p.x - board_x) < 0.5;
-  });
-  ASSERT_GT(scored.pixels.size(), 300u);
-  const Error one = error_against(layered_ao(s, cam, false), scored.reference, scored.pixels);
-  const Error three = error_against(layered_ao(s, cam, true), scored.reference, scored.pixels);
-  const double mean_reference = scored.mean_reference();
+  // The wall within 0.5 of the board on either side.
+  const double board_x = 0.1;
+  const BoardOnAWall b =
+      board_on_a_wall(board_x, 1.0, [&](const V3& p) { return std::fabs(p.x - board_x) < 0.5; });
+  const Error &one = b.one, &three = b.three;
+  const double mean_reference = b.mean_reference;
   std::printf(
       "[ measure  ] 2 cm board seen edge-on, %d wall px beside it (ray-traced mean %.4f): one "
       "layer RMSE %.4f bias %+.4f; 3 hits RMSE %.4f bias %+.4f\n",
@@ -633,21 +653,13 @@ TEST(Layers, ABoardSeenAtAnAngleDarkensTheWallOnItsHiddenSide) {
   // lie in free space, in front of what their pixels show, so neither sees the board; the
   // point halfway between lands on its right face, a solid 2 cm deep along the ray
   // (Hemisphere::between): the crossing test with that face's plane.
-  Camera cam;
-  cam.width = 256, cam.height = 192;
-  const double wall_z = -4.0, board_x = -0.5, thickness = 0.02, depth = 0.6;
-  const std::vector<Solid> solids = {
-      {{{0, 0, wall_z}, {0, 0, 1}}},
-      box({board_x - thickness, -10, wall_z - 0.5}, {board_x, 10, wall_z + depth})};
-  Scene s = ray_cast(cam, solids);
-  // The wall within the radius left of the board, the rows near the centre; 512 rays.
-  const Scored scored = score_where(s, solids, 512, 8, 80, 2, [&](const V3& p) {
-    return std::fabs(p.z - wall_z) < 1e-6 && p.x < board_x && p.x > board_x - kRadius;
+  // The wall within the radius left of the board's right face, at x = -0.5.
+  const double right_face = -0.5;
+  const BoardOnAWall b = board_on_a_wall(right_face - 0.02, 0.6, [&](const V3& p) {
+    return p.x < right_face && p.x > right_face - kRadius;
   });
-  ASSERT_GT(scored.pixels.size(), 300u);
-  const Error one = error_against(layered_ao(s, cam, false), scored.reference, scored.pixels);
-  const Error three = error_against(layered_ao(s, cam, true), scored.reference, scored.pixels);
-  const double mean_reference = scored.mean_reference();
+  const Error &one = b.one, &three = b.three;
+  const double mean_reference = b.mean_reference;
   std::printf(
       "[ measure  ] 2 cm board seen at an angle, %d wall px on its hidden side (ray-traced mean "
       "%.4f): one layer RMSE %.4f bias %+.4f; 3 hits RMSE %.4f bias %+.4f\n",
