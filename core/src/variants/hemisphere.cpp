@@ -148,6 +148,16 @@ HWY_INLINE M plane_shown_lanes(const HemisphereRowArgs& a, const LaneProjection<
   return hn::AndNot(hn::AndNot(found, unsure), shown);
 }
 
+// Hemisphere::sides_differ on lanes: points a and b lie on either side of the plane
+// dot(x, c) = w (c of any length).
+template <class VF>
+HWY_INLINE auto sides_differ_lanes(VF ax, VF ay, VF az, VF bx, VF by, VF bz, VF cx, VF cy, VF cz,
+                                   VF w) {
+  namespace hn = hwy::HWY_NAMESPACE;
+  return hn::Xor(hn::Gt(hn::MulAdd(ax, cx, hn::MulAdd(ay, cy, az * cz)), w),
+                 hn::Gt(hn::MulAdd(bx, cx, hn::MulAdd(by, cy, bz * cz)), w));
+}
+
 // Hemisphere::end_part on lanes: the part of a direction's cone at the radius past a plane,
 // from how far the direction's end lies past it (negative: short of it); not clamped.
 template <class VF>
@@ -277,8 +287,7 @@ HWY_INLINE VF between_lanes(const HemisphereRowArgs& a, const LaneProjection<VF>
   // The crossing test where a and b lie on either side of the thin solid's plane.
   const VF w = hn::MulAdd(qxv, cx, hn::MulAdd(qyv, cy, qzv * cz));
   const auto crosses = hn::And(hn::And(thin, hn::Lt(weight, one)),
-                               hn::Xor(hn::Gt(hn::MulAdd(ax, cx, hn::MulAdd(ay, cy, az * cz)), w),
-                                       hn::Gt(hn::MulAdd(bx, cx, hn::MulAdd(by, cy, bz * cz)), w)));
+                               sides_differ_lanes(ax, ay, az, bx, by, bz, cx, cy, cz, w));
   if (hn::AllFalse(df, crosses)) return weight;
   return hn::Max(
       weight, crossing_lanes(a, project, crosses, ax, ay, az, bx, by, bz, cx, cy, cz, w, extend));
@@ -570,8 +579,7 @@ HWY_NOINLINE void hemisphere_row_of(const HemisphereRowArgs& a, int y, int x0, i
           hw = hn::MulAdd(qxv, hnx, hn::MulAdd(qyv, hny, qzv * hnz));
         }
         const auto flips = [&](VF cx, VF cy, VF cz, VF w) {
-          return hn::Xor(hn::Gt(hn::MulAdd(ax, cx, hn::MulAdd(ay, cy, az * cz)), w),
-                         hn::Gt(hn::MulAdd(sx, cx, hn::MulAdd(sy, cy, sz * cz)), w));
+          return sides_differ_lanes(ax, ay, az, sx, sy, sz, cx, cy, cz, w);
         };
         const auto here = hn::And(hidden, flips(hnx, hny, hnz, hw));
         const VF cnx = hn::IfThenElse(here, hnx, pnx), cny = hn::IfThenElse(here, hny, pny),
