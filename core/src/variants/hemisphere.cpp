@@ -1151,9 +1151,9 @@ class Hemisphere final : public Variant {
   // apart), where the visible surface of its pixel is above the receiver's tangent plane (p,
   // normal, min_height):
   // - when it lies behind that surface and in front of the ray's next hit, the part of the
-  //   point's cone (0.5 / its width: half_inv_width) behind the surface or, if more, of the cone
-  //   at the direction's end past the surface's tangent plane, times the solid's weight: 1 when
-  //   the next hit is a back face that closes it, else by the assumed thickness;
+  //   point's cone (0.5 / its width: cone.half_inv_width_between) behind the surface or, if more,
+  //   of the cone at the direction's end past the surface's tangent plane, times the solid's
+  //   weight: 1 when the next hit is a back face that closes it, else by the assumed thickness;
   // - when the ray's hits there make a solid thinner along the ray than kThinSolidSegments x the
   //   segment, the segment may pass through it anywhere, not at its midpoint only: the crossing
   //   test with the surface's plane (a board beside the midpoint, both points in free space in
