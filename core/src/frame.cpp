@@ -95,9 +95,36 @@ namespace {
 // and its packed normal; `usable` false where the stop is not a step onto a farther surface.
 struct CarriedPlane {
   bool usable = false;
-  Vec3 n{0.0f, 0.0f, 0.0f};
-  float w = 0.0f;
   uint32_t packed = 0;
+  int reach = 0;  // pixels from the stop
+  // Where the ray through pixel (x, y)'s centre meets the plane: planar depth numerator / slope,
+  // both affine in x and y (Camera::depth_on_plane, written out once per plane).
+  float slope0 = 0.0f, slope_x = 0.0f, slope_y = 0.0f;
+  float numerator0 = 0.0f, numerator_x = 0.0f, numerator_y = 0.0f;
+
+  CarriedPlane() = default;
+  CarriedPlane(const CameraIntrinsics& cam, Vec3 n, float w, uint32_t packed_normal)
+      : usable(true), packed(packed_normal) {
+    // View x and y of pixel (x, y)'s centre at unit depth: x0 + x * scale_u, y0 - y * scale_v.
+    const float x0 = (0.5f - cam.center_u) * cam.scale_u, y0 = (cam.center_v - 0.5f) * cam.scale_v;
+    if (cam.orthographic) {  // from (X, Y, 0) along (0, 0, -1)
+      slope0 = -n.z;
+      numerator0 = w - n.x * x0 - n.y * y0;
+      numerator_x = -n.x * cam.scale_u, numerator_y = n.y * cam.scale_v;
+    } else {  // from the eye along (X, Y, -1)
+      slope0 = n.x * x0 + n.y * y0 - n.z;
+      slope_x = n.x * cam.scale_u, slope_y = -n.y * cam.scale_v;
+      numerator0 = w;
+    }
+  }
+  // The ray through pixel (x, y) meets the plane at planar depth numerator / slope; slope >= 0
+  // (0: along the plane).
+  void at(int x, int y, float& numerator, float& slope) const {
+    const float fx = static_cast<float>(x), fy = static_cast<float>(y);
+    slope = slope0 + slope_x * fx + slope_y * fy;
+    numerator = numerator0 + numerator_x * fx + numerator_y * fy;
+    if (slope < 0.0f) slope = -slope, numerator = -numerator;
+  }
 };
 
 // Whether neighbouring planar depths a and b lie on one surface: within Frame::kCarryJump of each
@@ -158,12 +185,18 @@ void for_each_run(int count, DepthAt depth_at, Parted parted, OnRun on_run) {
 }
 }  // namespace
 
-// Per tile, each of the four walks is a scan towards the pixels from kCarrySearch pixels beyond
+int Frame::carry_search() const {
+  return std::max(kCarrySearch, static_cast<int>(kCarryFlatReach *
+                                                 static_cast<float>(std::max(width_, height_))));
+}
+
+// Per tile, each of the four walks is a scan towards the pixels from carry_search() pixels beyond
 // the tile's edge, keeping the nearest stop seen so far (a step onto a farther surface, or
 // background) with its surface's plane: O(pixels) however far the search reaches, one plane per
-// stop, and per pixel where its ray meets the plane; of the four walks' planes, the one the ray
-// meets first.
+// stop (and a walk beyond it along its surface, for its reach), and per pixel where its ray meets
+// the plane; of the four walks' planes, the one the ray meets first.
 void Frame::find_carried_surfaces(TilePool& pool, Progress& progress) {
+  const int search = carry_search();
   if (extra_layers_ > 0 || normal_.empty()) {
     std::vector<float>().swap(carried_depth_);
     std::vector<uint32_t>().swap(carried_normal_);
@@ -175,9 +208,8 @@ void Frame::find_carried_surfaces(TilePool& pool, Progress& progress) {
   // past it where the surface goes on there (the first pixel across is often a mix of both in
   // the Normal pass).
   const auto plane_at = [&](int x, int y, int dx, int dy) {
-    CarriedPlane plane;
     const float far_side = depth(x, y);
-    if (far_side == kBackground) return plane;
+    if (far_side == kBackground) return CarriedPlane();
     const int gx = x + dx, gy = y + dy;
     if (gx >= 0 && gy >= 0 && gx < width_ && gy < height_ &&
         on_one_surface(depth(gx, gy), far_side)) {
@@ -185,40 +217,59 @@ void Frame::find_carried_surfaces(TilePool& pool, Progress& progress) {
     }
     const uint32_t packed = normal_[index(x, y)];
     const Vec3 n = decode_normal(packed), q = position(x, y);
-    return CarriedPlane{true, n, dot(q, n), packed};
+    CarriedPlane plane(camera_.intrinsics(), n, dot(q, n), packed);
+    // Carried as far as the surface was seen on its plane beyond the step (the floor beside a
+    // sphere, not a tube's side), and at least kCarrySearch; a surface that runs out of the
+    // frame as far as the search goes.
+    plane.reach = kCarrySearch;
+    for (int k = 1; k <= search; ++k) {
+      const int px = x + k * dx, py = y + k * dy;
+      if (px < 0 || py < 0 || px >= width_ || py >= height_) {
+        plane.reach = search;
+        break;
+      }
+      const float d = depth(px, py);
+      float numerator, slope;
+      plane.at(px, py, numerator, slope);
+      if (d == kBackground ||
+          !(std::fabs(numerator - d * slope) <= kCarryFlatTolerance * d * slope)) {
+        break;
+      }
+      plane.reach = std::max(plane.reach, k);
+    }
+    return plane;
   };
-  // Whole rows: the walks along a row need no pixels beyond the band, and those along a column
-  // kCarrySearch rows beyond it, a fraction of its kCarryBandRows.
+  // Pixel (x, y) of depth d, within the reach of the stop whose plane is `plane`: where its ray
+  // meets the plane, if farther than its surface by kCarryJump and nearer than the planes of the
+  // other stops (behind a sphere on a floor before a wall, the floor's plane from beside it,
+  // before the wall's from above it: the crease they make behind it).
+  const auto consider = [&](int x, int y, float d, const CarriedPlane& plane) {
+    if (!plane.usable || d == kBackground) return;
+    const size_t slot = index(x, y);
+    // meets = numerator / slope > d * kCarryJump and < the nearest so far, without the division.
+    float numerator, slope;
+    plane.at(x, y, numerator, slope);
+    if (!(slope > 1e-6f) || !(numerator > d * kCarryJump * slope) ||
+        !(numerator < carried_depth_[slot] * slope)) {
+      return;
+    }
+    carried_depth_[slot] = numerator / slope;
+    carried_normal_[slot] = plane.packed;
+  };
+  // Along rows, right then left, scanning against the walk: the nearest stop ahead (a pixel of
+  // background, or a step from the pixel before onto a surface farther by kCarryJump).
   constexpr int kCarryBandRows = 64;
   pool.for_each_row_band(width_, height_, kCarryBandRows, progress, [&](const Tile& t) {
-    const int w = width_, h = t.y1 - t.y0;
-    ScratchVector<float> best(size_t(w) * size_t(h));
-    std::fill(best.begin(), best.end(), kBackground);
-    uint32_t* normals_out = carried_normal_.data() + index(0, t.y0);
-    // Pixel (x, y) of depth d, within kCarrySearch pixels of the stop whose plane is `plane`:
-    // where its ray meets the plane, if farther than its surface by kCarryJump and nearer than
-    // the planes of the other stops (behind a sphere on a floor before a wall, the floor's plane
-    // from beside it, before the wall's from above it: the crease they make behind it).
-    const auto consider = [&](int x, int y, float d, const CarriedPlane& plane) {
-      const size_t slot = size_t(y - t.y0) * size_t(w) + size_t(x);
-      if (!plane.usable || d == kBackground) return;
-      float meets;
-      if (!camera_.depth_on_plane(float(x) + 0.5f, float(y) + 0.5f, plane.n, plane.w, meets) ||
-          !(meets > d * kCarryJump) || !(meets < best[slot])) {
-        return;
-      }
-      best[slot] = meets;
-      normals_out[slot] = plane.packed;
-    };
-    // Along rows, right then left, scanning against the walk: the nearest stop ahead (a pixel of
-    // background, or a step from the pixel before onto a surface farther by kCarryJump).
+    const int w = width_;
+    std::fill(carried_depth_.begin() + index(0, t.y0), carried_depth_.begin() + index(0, t.y1),
+              kBackground);
     for (int y = t.y0; y < t.y1; ++y) {
       const float* row = depth_.data() + index(0, y);
       for (const int dx : {1, -1}) {
         int stop = -1;
         CarriedPlane plane;
         for (int x = dx > 0 ? w - 1 : 0; x >= 0 && x < w; x -= dx) {
-          if (stop >= 0 && std::abs(stop - x) <= kCarrySearch) {
+          if (stop >= 0 && std::abs(stop - x) <= plane.reach) {
             consider(x, y, row[x], plane);
           }
           const int before = x - dx;
@@ -229,32 +280,33 @@ void Frame::find_carried_surfaces(TilePool& pool, Progress& progress) {
         }
       }
     }
-    // Along columns, down then up, the same with one stop per column.
+  });
+  // Along columns, down then up, the same with one stop per column: strips of whole columns,
+  // after every row (each pixel meets the four walks' planes in the same order as ever).
+
+  constexpr int kCarryStripColumns = 64;
+  pool.for_each_column_strip(width_, height_, kCarryStripColumns, progress, [&](const Tile& t) {
+    const int w = t.x1 - t.x0;
     ScratchVector<int> stop(static_cast<size_t>(w));
     ScratchVector<CarriedPlane> plane(static_cast<size_t>(w));
     for (const int dy : {1, -1}) {
       std::fill(stop.begin(), stop.end(), -1);
-      const int begin = dy > 0 ? std::min(t.y1 - 1 + kCarrySearch, height_ - 1)
-                               : std::max(t.y0 - kCarrySearch, 0);
-      const int end = dy > 0 ? t.y0 - 1 : t.y1;
-      for (int y = begin; y != end; y -= dy) {
-        const float* row = depth_.data() + index(0, y);
+      for (int y = dy > 0 ? height_ - 1 : 0; y >= 0 && y < height_; y -= dy) {
+        const float* row = depth_.data() + index(t.x0, y);
         const int before = y - dy;
         const float* row_before =
-            before >= 0 && before < height_ ? depth_.data() + index(0, before) : nullptr;
-        const bool inside = y >= t.y0 && y < t.y1;
-        for (int x = 0; x < w; ++x) {
-          if (inside && stop[size_t(x)] >= 0 && std::abs(stop[size_t(x)] - y) <= kCarrySearch) {
-            consider(x, y, row[x], plane[size_t(x)]);
+            before >= 0 && before < height_ ? depth_.data() + index(t.x0, before) : nullptr;
+        for (int i = 0; i < w; ++i) {
+          if (stop[size_t(i)] >= 0 && std::abs(stop[size_t(i)] - y) <= plane[size_t(i)].reach) {
+            consider(t.x0 + i, y, row[i], plane[size_t(i)]);
           }
-          if (row[x] == kBackground ||
-              (row_before != nullptr && row[x] > row_before[x] * kCarryJump)) {
-            stop[size_t(x)] = y, plane[size_t(x)] = plane_at(x, y, 0, dy);
+          if (row[i] == kBackground ||
+              (row_before != nullptr && row[i] > row_before[i] * kCarryJump)) {
+            stop[size_t(i)] = y, plane[size_t(i)] = plane_at(t.x0 + i, y, 0, dy);
           }
         }
       }
     }
-    std::copy(best.begin(), best.end(), carried_depth_.data() + index(0, t.y0));
   });
 }
 

@@ -223,8 +223,9 @@ class Frame {
   // Without extra layers, per pixel: the planar depth at which the pixel's ray meets the surfaces
   // beyond the silhouettes around it, carried on behind the object as their tangent planes (the
   // floor going on under a sphere): walking from the pixel along its row and its column, the
-  // first step onto a surface more than kCarryJump farther, within kCarrySearch pixels, on each
-  // of the four sides; of their planes that the ray meets more than kCarryJump behind the pixel's
+  // first step onto a surface more than kCarryJump farther, on each of the four sides, within
+  // kCarrySearch pixels or as far as that surface was seen on its plane beyond the step
+  // (kCarryFlatReach); of their planes that the ray meets more than kCarryJump behind the pixel's
   // own surface, the nearest; kBackground where none. Null with extra layers (they show the hidden
   // surfaces) or without normals.
   const float* carried_depth_plane() const {
@@ -239,6 +240,14 @@ class Frame {
   }
   Vec3 carried_normal(int x, int y) const { return decode_normal(carried_normal_[index(x, y)]); }
   static constexpr int kCarrySearch = 24;
+  // How far a surface is carried at most, as a fraction of the frame's larger side; within that,
+  // as far as the surface was seen beyond the step on its plane, to within kCarryFlatTolerance of
+  // the depth.
+  static constexpr float kCarryFlatReach = 0.15f;
+  static constexpr float kCarryFlatTolerance = 0.01f;
+  // The pixels a walk looks past a tile's edge: kCarryFlatReach of the frame, at least
+  // kCarrySearch.
+  int carry_search() const;
   static constexpr float kCarryJump = 1.05f;
 
  private:

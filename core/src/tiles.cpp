@@ -139,6 +139,11 @@ void TilePool::for_each_row_band(int width, int height, int rows, Progress& prog
   run(width, height, std::max(1, width), std::max(1, rows), progress, fn);
 }
 
+void TilePool::for_each_column_strip(int width, int height, int columns, Progress& progress,
+                                     const std::function<void(const Tile&)>& fn) {
+  run(width, height, std::max(1, columns), std::max(1, height), progress, fn);
+}
+
 void TilePool::run(int width, int height, int tile_width, int tile_height, Progress& progress,
                    const std::function<void(const Tile&)>& fn) {
   if (width <= 0 || height <= 0) return;

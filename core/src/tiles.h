@@ -55,6 +55,9 @@ class TilePool {
   // Same over whole rows (tiles of full width and `rows` height), for row-wise filters.
   void for_each_row_band(int width, int height, int rows, Progress& progress,
                          const std::function<void(const Tile&)>& fn);
+  // Same over whole columns (tiles of full height and `columns` width), for column-wise walks.
+  void for_each_column_strip(int width, int height, int columns, Progress& progress,
+                             const std::function<void(const Tile&)>& fn);
 
  private:
   void run(int width, int height, int tile_width, int tile_height, Progress& progress,

@@ -430,6 +430,76 @@ TEST(Frame, LastThicknessIsMeasuredBesideTheForeground) {
   }
 }
 
+TEST(Frame, SurfacesAreCarriedAsFarAsTheyWereSeenFlat) {
+  // A board 5 before the camera, in front of a flat wall 10 away, alone or framed by a ring of
+  // boxes 7 away that leaves the wall showing in a gap of about 8 pixels around the board. One
+  // layer: the surface beyond each silhouette is carried on behind the board
+  // (Frame::carried_depth) as far as it was seen on its plane beyond the step, at least
+  // kCarrySearch pixels: the open wall's across the board, the framed wall's a band of
+  // kCarrySearch pixels along its edges.
+  Camera c;
+  c.width = 320, c.height = 240;
+  for (const bool open : {true, false}) {
+    std::vector<Solid> solids = {{{{0, 0, -10}, {0, 0, 1}}},
+                                 box({-0.8, -0.6, -5.2}, {0.8, 0.6, -5.0})};
+    if (!open) {
+      solids.push_back(box({-4, -4, -7.2}, {-1.27, 4, -7.0}));
+      solids.push_back(box({1.27, -4, -7.2}, {4, 4, -7.0}));
+      solids.push_back(box({-1.27, 0.99, -7.2}, {1.27, 4, -7.0}));
+      solids.push_back(box({-1.27, -4, -7.2}, {1.27, -0.99, -7.0}));
+    }
+    Scene s = ray_cast(c, solids);
+    ssao::FrameInputs in;
+    in.depth = {s.depth.data(), s.width, s.height, 1, 4, 4 * std::ptrdiff_t(s.width)};
+    in.normal = {s.normal.data(), s.width, s.height, 3, 12, 12 * std::ptrdiff_t(s.width)};
+    in.world_normals = false;
+    in.assumed_thickness = 0.5f;
+    ssao::TilePool pool(2);
+    ssao::Progress progress(nullptr, nullptr);
+    ssao::Frame f;
+    f.reset(camera_model(c, s.width, s.height), s.width, s.height, 0);
+    f.build(in, pool, progress, ssao::kAllFrameExtras);
+    ASSERT_NE(f.carried_depth_plane(), nullptr);
+    // The board's pixels farther than kCarrySearch from its silhouette on every side, and the
+    // ones the wall's or ball's plane reaches there.
+    int board = 0, deep = 0, carried = 0, on_the_wall = 0, band_on_the_wall = 0;
+    for (int y = 0; y < s.height; ++y) {
+      for (int x = 0; x < s.width; ++x) {
+        if (!(std::fabs(f.depth(x, y) - 5.0f) < 0.01f)) continue;
+        ++board;
+        bool inside = true;
+        for (const auto& step : {std::array<int, 2>{1, 0}, {-1, 0}, {0, 1}, {0, -1}}) {
+          const int ex = x + step[0] * (ssao::Frame::kCarrySearch + 1);
+          const int ey = y + step[1] * (ssao::Frame::kCarrySearch + 1);
+          inside = inside && ex >= 0 && ey >= 0 && ex < s.width && ey < s.height &&
+                   std::fabs(f.depth(ex, ey) - 5.0f) < 0.01f;
+        }
+        const float d = f.carried_depth(x, y);
+        if (!inside) {
+          band_on_the_wall += std::fabs(d - 10.0f) < 0.01f ? 1 : 0;
+          continue;
+        }
+        ++deep;
+        if (!std::isfinite(d)) continue;
+        ++carried;
+        on_the_wall += std::fabs(d - 10.0f) < 0.01f ? 1 : 0;
+      }
+    }
+    std::printf(
+        "[ measure  ] %s: board %d px, %d beyond kCarrySearch of its edges, %d of them "
+        "with a carried surface (%d at the wall's depth); %d nearer its edges at the "
+        "wall's depth\n",
+        open ? "open wall" : "framed wall", board, deep, carried, on_the_wall, band_on_the_wall);
+    ASSERT_GT(deep, 1000);
+    EXPECT_GT(band_on_the_wall, (board - deep) * 9 / 10);
+    if (open) {
+      EXPECT_EQ(on_the_wall, deep);
+    } else {
+      EXPECT_EQ(carried, 0);
+    }
+  }
+}
+
 TEST(Frame, BesideBackgroundRowMatchesTheNeighboursOneByOne) {
   // Sky scattered over frames from 1x1 up, every row asked whole and in windows that start and
   // end at the frame's borders and inside it: each flag must say whether one of the (up to 8)
