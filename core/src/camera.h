@@ -28,6 +28,36 @@ struct CameraIntrinsics {
   float scale_u, scale_v, center_u, center_v;
 };
 
+// CameraModel::depth_on_plane for the centres of whole pixels (x, y), written out once per plane
+// dot(p, n) = w: the ray through pixel (x, y) meets the plane at planar depth numerator / slope,
+// both affine in x and y, so a walk over many pixels needs no division to compare depths.
+struct PlaneDepths {
+  float slope0 = 0.0f, slope_x = 0.0f, slope_y = 0.0f;
+  float numerator0 = 0.0f, numerator_x = 0.0f, numerator_y = 0.0f;
+
+  PlaneDepths() = default;
+  PlaneDepths(const CameraIntrinsics& cam, Vec3 n, float w) {
+    // View x and y of pixel (x, y)'s centre at unit depth: x0 + x * scale_u, y0 - y * scale_v.
+    const float x0 = (0.5f - cam.center_u) * cam.scale_u, y0 = (cam.center_v - 0.5f) * cam.scale_v;
+    if (cam.orthographic) {  // from (X, Y, 0) along (0, 0, -1)
+      slope0 = -n.z;
+      numerator0 = w - n.x * x0 - n.y * y0;
+      numerator_x = -n.x * cam.scale_u, numerator_y = n.y * cam.scale_v;
+    } else {  // from the eye along (X, Y, -1)
+      slope0 = n.x * x0 + n.y * y0 - n.z;
+      slope_x = n.x * cam.scale_u, slope_y = -n.y * cam.scale_v;
+      numerator0 = w;
+    }
+  }
+  // Pixel (x, y)'s numerator and slope, the sign chosen so that slope >= 0 (0: along the plane).
+  void at(int x, int y, float& numerator, float& slope) const {
+    const float fx = static_cast<float>(x), fy = static_cast<float>(y);
+    slope = slope0 + slope_x * fx + slope_y * fy;
+    numerator = numerator0 + numerator_x * fx + numerator_y * fy;
+    if (slope < 0.0f) slope = -slope, numerator = -numerator;
+  }
+};
+
 class CameraModel {
  public:
   // Mirrors Blender's viewplane computation (BKE_camera_params_compute_viewplane).
@@ -89,7 +119,7 @@ class CameraModel {
   }
 
   // Planar depth at which the ray through continuous image coordinates (u, v) meets the plane
-  // dot(x, n) = w; false where the ray runs along the plane.
+  // dot(x, n) = w; false where the ray runs along the plane (PlaneDepths: the same over pixels).
   bool depth_on_plane(float u, float v, Vec3 n, float w, float& planar_depth) const {
     const Vec3 origin = view_position(u, v, 0.0f);
     const float slope = dot(view_position(u, v, 1.0f) - origin, n);

@@ -91,40 +91,14 @@ SSAO_VECTORIZE void Frame::plane_distance_scale_row(int x0, int count, int y,
 }
 
 namespace {
-// The tangent plane dot(x, n) = w of the surface beyond a stop of a walk (Frame::carried_depth),
-// and its packed normal; `usable` false where the stop is not a step onto a farther surface.
+// The tangent plane of the surface beyond a stop of a walk (Frame::carried_depth): where pixels'
+// rays meet it, its packed normal, and how many pixels back from the stop it is carried; `usable`
+// false where the stop is not a step onto a farther surface.
 struct CarriedPlane {
   bool usable = false;
   uint32_t packed = 0;
-  int reach = 0;  // pixels from the stop
-  // Where the ray through pixel (x, y)'s centre meets the plane: planar depth numerator / slope,
-  // both affine in x and y (Camera::depth_on_plane, written out once per plane).
-  float slope0 = 0.0f, slope_x = 0.0f, slope_y = 0.0f;
-  float numerator0 = 0.0f, numerator_x = 0.0f, numerator_y = 0.0f;
-
-  CarriedPlane() = default;
-  CarriedPlane(const CameraIntrinsics& cam, Vec3 n, float w, uint32_t packed_normal)
-      : usable(true), packed(packed_normal) {
-    // View x and y of pixel (x, y)'s centre at unit depth: x0 + x * scale_u, y0 - y * scale_v.
-    const float x0 = (0.5f - cam.center_u) * cam.scale_u, y0 = (cam.center_v - 0.5f) * cam.scale_v;
-    if (cam.orthographic) {  // from (X, Y, 0) along (0, 0, -1)
-      slope0 = -n.z;
-      numerator0 = w - n.x * x0 - n.y * y0;
-      numerator_x = -n.x * cam.scale_u, numerator_y = n.y * cam.scale_v;
-    } else {  // from the eye along (X, Y, -1)
-      slope0 = n.x * x0 + n.y * y0 - n.z;
-      slope_x = n.x * cam.scale_u, slope_y = -n.y * cam.scale_v;
-      numerator0 = w;
-    }
-  }
-  // The ray through pixel (x, y) meets the plane at planar depth numerator / slope; slope >= 0
-  // (0: along the plane).
-  void at(int x, int y, float& numerator, float& slope) const {
-    const float fx = static_cast<float>(x), fy = static_cast<float>(y);
-    slope = slope0 + slope_x * fx + slope_y * fy;
-    numerator = numerator0 + numerator_x * fx + numerator_y * fy;
-    if (slope < 0.0f) slope = -slope, numerator = -numerator;
-  }
+  int reach = 0;
+  PlaneDepths depths;
 };
 
 // Whether neighbouring planar depths a and b lie on one surface: within Frame::kCarryJump of each
@@ -190,11 +164,11 @@ int Frame::carry_search() const {
                                                  static_cast<float>(std::max(width_, height_))));
 }
 
-// Per tile, each of the four walks is a scan towards the pixels from carry_search() pixels beyond
-// the tile's edge, keeping the nearest stop seen so far (a step onto a farther surface, or
-// background) with its surface's plane: O(pixels) however far the search reaches, one plane per
-// stop (and a walk beyond it along its surface, for its reach), and per pixel where its ray meets
-// the plane; of the four walks' planes, the one the ray meets first.
+// Each of the four walks scans a whole row or column towards the pixels, keeping the nearest stop
+// seen so far (a step onto a farther surface, or background) with its surface's plane: O(pixels)
+// however far the planes reach, one plane per stop (and a walk of up to carry_search() pixels
+// beyond it along its surface, for its reach), and per pixel where its ray meets the plane; of
+// the four walks' planes, the one the ray meets first.
 void Frame::find_carried_surfaces(TilePool& pool, Progress& progress) {
   const int search = carry_search();
   if (extra_layers_ > 0 || normal_.empty()) {
@@ -217,7 +191,7 @@ void Frame::find_carried_surfaces(TilePool& pool, Progress& progress) {
     }
     const uint32_t packed = normal_[index(x, y)];
     const Vec3 n = decode_normal(packed), q = position(x, y);
-    CarriedPlane plane(camera_.intrinsics(), n, dot(q, n), packed);
+    CarriedPlane plane{true, packed, 0, PlaneDepths(camera_.intrinsics(), n, dot(q, n))};
     // Carried as far as the surface was seen on its plane beyond the step (the floor beside a
     // sphere, not a tube's side), and at least kCarrySearch; a surface that runs out of the
     // frame as far as the search goes.
@@ -230,7 +204,7 @@ void Frame::find_carried_surfaces(TilePool& pool, Progress& progress) {
       }
       const float d = depth(px, py);
       float numerator, slope;
-      plane.at(px, py, numerator, slope);
+      plane.depths.at(px, py, numerator, slope);
       if (d == kBackground ||
           !(std::fabs(numerator - d * slope) <= kCarryFlatTolerance * d * slope)) {
         break;
@@ -248,7 +222,7 @@ void Frame::find_carried_surfaces(TilePool& pool, Progress& progress) {
     const size_t slot = index(x, y);
     // meets = numerator / slope > d * kCarryJump and < the nearest so far, without the division.
     float numerator, slope;
-    plane.at(x, y, numerator, slope);
+    plane.depths.at(x, y, numerator, slope);
     if (!(slope > 1e-6f) || !(numerator > d * kCarryJump * slope) ||
         !(numerator < carried_depth_[slot] * slope)) {
       return;
@@ -283,7 +257,6 @@ void Frame::find_carried_surfaces(TilePool& pool, Progress& progress) {
   });
   // Along columns, down then up, the same with one stop per column: strips of whole columns,
   // after every row (each pixel meets the four walks' planes in the same order as ever).
-
   constexpr int kCarryStripColumns = 64;
   pool.for_each_column_strip(width_, height_, kCarryStripColumns, progress, [&](const Tile& t) {
     const int w = t.x1 - t.x0;

@@ -245,7 +245,7 @@ class Frame {
   // the depth.
   static constexpr float kCarryFlatReach = 0.15f;
   static constexpr float kCarryFlatTolerance = 0.01f;
-  // The pixels a walk looks past a tile's edge: kCarryFlatReach of the frame, at least
+  // The farthest a plane is carried, in pixels: kCarryFlatReach of the frame, at least
   // kCarrySearch.
   int carry_search() const;
   static constexpr float kCarryJump = 1.05f;

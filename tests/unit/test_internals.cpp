@@ -460,8 +460,8 @@ TEST(Frame, SurfacesAreCarriedAsFarAsTheyWereSeenFlat) {
     f.reset(camera_model(c, s.width, s.height), s.width, s.height, 0);
     f.build(in, pool, progress, ssao::kAllFrameExtras);
     ASSERT_NE(f.carried_depth_plane(), nullptr);
-    // The board's pixels farther than kCarrySearch from its silhouette on every side, and the
-    // ones the wall's or ball's plane reaches there.
+    // The board's pixels farther than kCarrySearch from its silhouette on every side, those of
+    // them the wall's plane reaches, and those nearer its edges that it reaches.
     int board = 0, deep = 0, carried = 0, on_the_wall = 0, band_on_the_wall = 0;
     for (int y = 0; y < s.height; ++y) {
       for (int x = 0; x < s.width; ++x) {
